@@ -1,0 +1,221 @@
+#pragma once
+// Bodies of EkfSlam (see ../ekf_slam.hpp).
+
+#include <string>
+#include <utility>
+
+#include "sextant/core/chi_square.hpp"
+#include "sextant/core/validation.hpp"
+
+namespace sextant {
+
+template <class Motion, class Sensor>
+EkfSlam<Motion, Sensor>::EkfSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, EkfOptions options)
+    : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), x_(prior.mean), cov_(X) {
+  if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
+  cholesky_or_throw(prior.cov, "prior covariance");
+  if (options_.gate_probability != 0.0) gate_threshold_ = chi_square_quantile(Z, options_.gate_probability);
+  cov_.view() = symmetrized(prior.cov);
+}
+
+/// Thesis eqs. (10)-(13): mu' = g(u, mu); P_xx' = G P_xx G^T + R; P_xm' = G P_xm. O(n).
+template <class Motion, class Sensor>
+void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
+  require_finite(u, "control");
+  require_positive_time_step(dt);
+  const auto prediction = motion_.predict(x_, u, dt);
+  if (!Space::is_finite(prediction.x) || !prediction.J_x_x.allFinite() || !prediction.R.allFinite())
+    throw numerical_error("motion model returned NaN or Inf");
+  auto P = cov_.view();
+  const auto& G = prediction.J_x_x;
+  const Eigen::Index rest = P.rows() - X;
+  P.template topLeftCorner<X, X>() =
+      symmetrized(G * symmetric_diagonal_block<X>(P, 0) * G.transpose() + prediction.R);
+  if (rest > 0) P.bottomLeftCorner(rest, X) = (P.bottomLeftCorner(rest, X) * G.transpose()).eval();
+  x_ = prediction.x;
+}
+
+/// Batch mode: one joint correction, planned in full before anything changes. Sequential mode:
+/// one correction per observation on a snapshot that is restored if any step throws.
+template <class Motion, class Sensor>
+UpdateResult EkfSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
+  require_valid_observations(observations);
+  std::vector<ObservationType> known, fresh;
+  for (const auto& observation : observations)
+    (pool_.contains(observation.landmark_id) ? known : fresh).push_back(observation);
+  UpdateResult result;
+  if (options_.batch_update || known.size() <= 1) {
+    commit(plan(known, fresh, result));
+    return result;
+  }
+  const State x_before = x_;
+  const Eigen::VectorXd means_before = landmark_means_;
+  const GrowableSquareMatrix cov_before = cov_;
+  try {
+    const std::span<const ObservationType> all_known(known);
+    for (std::size_t i = 0; i < known.size(); ++i) commit(plan(all_known.subspan(i, 1), {}, result));
+    commit(plan({}, fresh, result));
+  } catch (...) {
+    x_ = x_before;
+    landmark_means_ = means_before;
+    cov_ = cov_before;
+    throw;
+  }
+  return result;
+}
+
+template <class Motion, class Sensor>
+auto EkfSlam<Motion, Sensor>::linearize(std::span<const ObservationType> known) const -> std::vector<Linearized> {
+  std::vector<Linearized> out;
+  out.reserve(known.size());
+  for (const auto& observation : known) {
+    const std::size_t slot = pool_.slot(observation.landmark_id);
+    out.push_back(linearize_observation(sensor_, x_, landmark_mean(slot), observation.z, observation.landmark_id,
+                                        offset_of(slot)));
+  }
+  return out;
+}
+
+/// P H_i^T for one observation, from the robot and landmark column blocks only: O(n).
+template <class Motion, class Sensor>
+auto EkfSlam<Motion, Sensor>::cross_covariance(const Linearized& obs) const -> Eigen::Matrix<double, Eigen::Dynamic, Z> {
+  const auto P = cov_.view();
+  return symmetric_column_block<X>(P, 0) * obs.J_z_x.transpose() +
+         symmetric_column_block<M>(P, obs.offset) * obs.J_z_m.transpose();
+}
+
+/// Removes observations whose innovation is implausible: nu^T S^-1 nu > chi2_Z(gate_probability).
+template <class Motion, class Sensor>
+void EkfSlam<Motion, Sensor>::gate(std::vector<Linearized>& observations, UpdateResult& result) const {
+  if (gate_threshold_ <= 0.0) return;
+  std::vector<Linearized> kept;
+  for (auto& obs : observations) {
+    const auto C = cross_covariance(obs);
+    const Eigen::Matrix<double, Z, Z> S = symmetrized(
+        obs.J_z_x * C.template topRows<X>() + obs.J_z_m * C.template middleRows<M>(obs.offset) + obs.Q);
+    const auto llt = cholesky_or_throw(S, "innovation covariance of landmark " + std::to_string(obs.id));
+    if (mahalanobis_squared(llt, obs.residual) > gate_threshold_)
+      result.rejected.push_back(obs.id);
+    else
+      kept.push_back(std::move(obs));
+  }
+  observations = std::move(kept);
+}
+
+/// Thesis eqs. (14)-(16) for k observations at once: C = P H^T, S = H C + Q, delta = C S^-1 nu.
+template <class Motion, class Sensor>
+auto EkfSlam<Motion, Sensor>::compute_correction(const std::vector<Linearized>& observations) const -> Correction {
+  const Eigen::Index n = state_dim(), k = static_cast<Eigen::Index>(observations.size());
+  Correction out;
+  out.C.resize(n, Z * k);
+  Eigen::VectorXd nu(Z * k);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    out.C.template middleCols<Z>(Z * i) = cross_covariance(observations[i]);
+    nu.template segment<Z>(Z * i) = observations[i].residual;
+  }
+  out.S.resize(Z * k, Z * k);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const auto& obs = observations[i];
+    out.S.template middleRows<Z>(Z * i) =
+        obs.J_z_x * out.C.template topRows<X>() + obs.J_z_m * out.C.template middleRows<M>(obs.offset);
+    out.S.template block<Z, Z>(Z * i, Z * i) += obs.Q;
+  }
+  out.S = symmetrized(out.S);
+  const auto llt = cholesky_or_throw(out.S, "innovation covariance S");
+  out.L = llt.matrixL();
+  out.delta = out.C * llt.solve(nu);
+  if (!out.delta.allFinite()) throw numerical_error("EKF correction is not finite");
+  return out;
+}
+
+/// Commits a correction: mean by plus (error state), covariance by eq. (17) or Joseph form.
+template <class Motion, class Sensor>
+void EkfSlam<Motion, Sensor>::apply(const Correction& correction) {
+  auto P = cov_.view();
+  const auto L = correction.L.template triangularView<Eigen::Lower>();
+  if (options_.covariance_update == CovarianceUpdate::symmetric) {
+    const Eigen::MatrixXd W = L.solve(correction.C.transpose());  // P -= C S^-1 C^T = W^T W
+    subtract_gram_lower(P, W);
+  } else {
+    // (I-KH)P(I-KH)^T + KQK^T = P - K C^T - C K^T + K S K^T with K = C S^-1.
+    const Eigen::MatrixXd K = L.transpose().solve(L.solve(correction.C.transpose())).transpose();
+    const Eigen::MatrixXd KL = K * correction.L;
+    auto lower = P.template selfadjointView<Eigen::Lower>();
+    for (Eigen::Index i = 0; i < K.cols(); ++i) lower.rankUpdate(K.col(i), correction.C.col(i), -1.0);
+    lower.rankUpdate(KL, 1.0);
+  }
+  x_ = Space::plus(x_, correction.delta.template head<X>());
+  landmark_means_ += correction.delta.tail(correction.delta.size() - X);
+}
+
+template <class Motion, class Sensor>
+auto EkfSlam<Motion, Sensor>::plan(std::span<const ObservationType> known, std::span<const ObservationType> fresh,
+                                   UpdateResult& result) const -> Plan {
+  Plan out;
+  std::vector<Linearized> observations = linearize(known);
+  gate(observations, result);
+  State x_after = x_;
+  if (!observations.empty()) {
+    out.correction = compute_correction(observations);
+    x_after = Space::plus(x_, out.correction->delta.template head<X>());
+    result.corrected += observations.size();
+  }
+  for (const auto& observation : fresh) {
+    const Init init = sensor_.initialize(x_after, observation.z);
+    if (!init.m.allFinite() || !init.J_m_x.allFinite() || !init.J_m_z.allFinite() || !init.Q.allFinite())
+      throw numerical_error("inverse measurement model returned NaN or Inf for landmark " +
+                            std::to_string(observation.landmark_id));
+    out.new_landmarks.emplace_back(observation.landmark_id, init);
+  }
+  result.initialized += out.new_landmarks.size();
+  return out;
+}
+
+template <class Motion, class Sensor>
+void EkfSlam<Motion, Sensor>::commit(const Plan& plan) {
+  if (plan.correction) apply(*plan.correction);
+  for (const auto& [id, init] : plan.new_landmarks) augment(id, init);
+}
+
+/// State augmentation with the inverse model: P_mm = J_m_x P_xx J_m_x^T + J_m_z Q J_m_z^T,
+/// P_m,rest = J_m_x P_x,rest (the cross-covariance that makes new landmarks correlated with the robot).
+template <class Motion, class Sensor>
+void EkfSlam<Motion, Sensor>::augment(LandmarkId id, const Init& init) {
+  const Eigen::Index offset = cov_.dim();
+  pool_.add(id);
+  cov_.grow(M);
+  auto P = cov_.view();
+  const Eigen::Matrix<double, X, X> P_xx = symmetric_diagonal_block<X>(P, 0);
+  P.block(offset, 0, M, X) = init.J_m_x * P_xx;
+  P.block(offset, X, M, offset - X) = init.J_m_x * P.block(X, 0, offset - X, X).transpose();
+  P.template block<M, M>(offset, offset) =
+      symmetrized(init.J_m_x * P_xx * init.J_m_x.transpose() + init.J_m_z * init.Q * init.J_m_z.transpose());
+  landmark_means_.conservativeResize(landmark_means_.size() + M);
+  landmark_means_.template tail<M>() = init.m;
+}
+
+/// Marginalization in moment form: drop the landmark's rows and columns (thesis §4.2.2).
+template <class Motion, class Sensor>
+void EkfSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
+  const auto removal = pool_.remove(id);
+  auto P = cov_.view();
+  mirror_lower_to_upper(P);  // the move below reads whole rows and columns
+  cov_.remove_block_by_moving_last(offset_of(removal.freed_slot), M);
+  landmark_means_.template segment<M>(M * removal.freed_slot) = landmark_means_.template segment<M>(M * removal.last_slot);
+  landmark_means_.conservativeResize(landmark_means_.size() - M);
+}
+
+template <class Motion, class Sensor>
+auto EkfSlam<Motion, Sensor>::landmark_at(std::size_t slot) const -> LandmarkEstimate<M> {
+  return {pool_.id_at(slot), landmark_mean(slot), symmetric_diagonal_block<M>(cov_.view(), offset_of(slot))};
+}
+
+template <class Motion, class Sensor>
+auto EkfSlam<Motion, Sensor>::map() const -> MapEstimate {
+  MapEstimate out;
+  out.reserve(pool_.size());
+  for (std::size_t slot = 0; slot < pool_.size(); ++slot) out.push_back(landmark_at(slot));
+  return out;
+}
+
+}  // namespace sextant

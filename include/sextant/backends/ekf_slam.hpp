@@ -1,0 +1,131 @@
+#pragma once
+/// \file EKF-SLAM (thesis §3.4) for any motion and measurement model pair.
+
+#include <Eigen/Core>
+#include <optional>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "sextant/core/concepts.hpp"
+#include "sextant/core/gaussian.hpp"
+#include "sextant/core/landmark_pool.hpp"
+#include "sextant/core/linearized_observation.hpp"
+#include "sextant/core/symmetric_matrix.hpp"
+#include "sextant/core/update_result.hpp"
+
+namespace sextant {
+
+/// How the covariance is corrected after a measurement update.
+enum class CovarianceUpdate {
+  /// P <- P - C S^-1 C^T with C = P H^T, as a symmetric rank update (thesis eq. 17).
+  symmetric,
+  /// Joseph form (I - K H) P (I - K H)^T + K Q K^T, kept block-sparse in H.
+  joseph,
+};
+
+struct EkfOptions {
+  bool batch_update = true;  ///< one joint correction per step (one pass over P) or one per observation
+  CovarianceUpdate covariance_update = CovarianceUpdate::symmetric;
+  double gate_probability = 0.0;  ///< in (0, 1): reject observations with NIS above the chi2 quantile; 0 = off
+};
+
+/// EKF-SLAM: joint Gaussian over the robot state and a growing set of landmarks. Only the lower
+/// triangle of the joint covariance P is stored and updated, which halves the memory traffic of
+/// the O(n^2) covariance correction.
+/// Prediction touches only the robot rows and columns of P (eqs. 10-13); an update uses only the
+/// robot and landmark blocks of H, so P H^T costs O(n) per observation (eqs. 14-17); new landmarks
+/// are added with the cross-covariance of the model's inverse.
+template <class Motion, class Sensor>
+class EkfSlam {
+  static_assert(MotionModel<Motion>,
+                "EkfSlam<Motion, Sensor>: Motion must satisfy sextant::MotionModel (types State, Control, Space, "
+                "constant kDim, and predict(x, u, dt) returning MotionPrediction<State, kDim>)");
+  static_assert(MeasurementModelFor<Sensor, Motion>,
+                "EkfSlam<Motion, Sensor>: Sensor must satisfy sextant::MeasurementModelFor<Sensor, Motion> (fixed-size "
+                "Eigen Landmark and Measurement, predict(x, m) -> MeasurementPrediction, residual(z, z_hat), "
+                "initialize(x, z) -> LandmarkInit)");
+
+ public:
+  using State = typename Motion::State;
+  using Control = typename Motion::Control;
+  using Space = typename Motion::Space;
+  using Landmark = typename Sensor::Landmark;
+  using Measurement = typename Sensor::Measurement;
+  using ObservationType = Observation<Measurement>;
+  static constexpr int X = Motion::kDim;
+  static constexpr int M = landmark_dim_v<Sensor>;
+  static constexpr int Z = measurement_dim_v<Sensor>;
+  using PoseEstimate = Gaussian<State, X>;
+  using MapEstimate = std::vector<LandmarkEstimate<M>>;
+
+  EkfSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, EkfOptions options = {});
+
+  /// Motion update over dt with control u (eqs. 10-11). Throws invalid_input_error on NaN/Inf or dt <= 0.
+  void predict(const Control& u, double dt);
+
+  /// Corrects with observations of known landmarks and adds the unknown ones to the map.
+  /// Throws on NaN/Inf, repeated ids or a non positive definite innovation; the state is then unchanged.
+  UpdateResult update(std::span<const ObservationType> observations);
+  UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }
+
+  /// Marginalizes a landmark out of the joint Gaussian. Throws unknown_landmark_error.
+  void remove_landmark(LandmarkId id);
+
+  PoseEstimate pose() const { return {x_, symmetric_diagonal_block<X>(cov_.view(), 0)}; }
+  LandmarkEstimate<M> landmark(LandmarkId id) const { return landmark_at(pool_.slot(id)); }
+  MapEstimate map() const;
+  bool has_landmark(LandmarkId id) const { return pool_.contains(id); }
+  std::size_t num_landmarks() const { return pool_.size(); }
+  /// Joint covariance of (robot, landmarks in slot order), dimension X + M * num_landmarks().
+  /// A copy: O(n^2).
+  Eigen::MatrixXd covariance() const { return cov_.view().template selfadjointView<Eigen::Lower>(); }
+  /// Dimension of the joint state, X + M * num_landmarks().
+  Eigen::Index state_dim() const { return cov_.dim(); }
+  const std::vector<LandmarkId>& landmark_ids() const { return pool_.ids(); }
+  const EkfOptions& options() const { return options_; }
+
+ private:
+  using Linearized = LinearizedObservation<Z, X, M>;
+  using Init = LandmarkInit<M, X, Z>;
+  /// A correction computed without touching the state: delta for the mean and the factors of
+  /// the covariance decrease.
+  struct Correction {
+    Eigen::VectorXd delta;
+    Eigen::MatrixXd C;        ///< P H^T (n x Zk)
+    Eigen::MatrixXd S;        ///< innovation covariance
+    Eigen::MatrixXd L;        ///< lower Cholesky factor of S
+  };
+
+  static Eigen::Index offset_of(std::size_t slot) { return X + M * static_cast<Eigen::Index>(slot); }
+  LandmarkEstimate<M> landmark_at(std::size_t slot) const;
+  Landmark landmark_mean(std::size_t slot) const { return landmark_means_.template segment<M>(M * slot); }
+
+  /// Everything one update will change, computed without touching the state.
+  struct Plan {
+    std::optional<Correction> correction;
+    std::vector<std::pair<LandmarkId, Init>> new_landmarks;
+  };
+
+  std::vector<Linearized> linearize(std::span<const ObservationType> known) const;
+  Eigen::Matrix<double, Eigen::Dynamic, Z> cross_covariance(const Linearized& obs) const;
+  void gate(std::vector<Linearized>& observations, UpdateResult& result) const;
+  Correction compute_correction(const std::vector<Linearized>& observations) const;
+  Plan plan(std::span<const ObservationType> known, std::span<const ObservationType> fresh, UpdateResult& result) const;
+  void commit(const Plan& plan);
+  void apply(const Correction& correction);
+  void augment(LandmarkId id, const Init& init);
+
+  Motion motion_;
+  Sensor sensor_;
+  EkfOptions options_;
+  double gate_threshold_ = 0.0;
+  State x_;
+  Eigen::VectorXd landmark_means_;
+  GrowableSquareMatrix cov_;  ///< P; only its lower triangle is kept up to date
+  LandmarkPool pool_;
+};
+
+}  // namespace sextant
+
+#include "sextant/backends/detail/ekf_slam_impl.hpp"

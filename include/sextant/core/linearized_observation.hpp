@@ -1,0 +1,40 @@
+#pragma once
+/// \file One observation linearized at the current estimate: the two non-zero blocks of H, the
+/// noise and the residual. Filters in moment and information form consume the same record.
+
+#include <Eigen/Core>
+#include <string>
+
+#include "sextant/core/error.hpp"
+#include "sextant/core/observation.hpp"
+
+namespace sextant {
+
+template <int Z, int X, int M>
+struct LinearizedObservation {
+  LandmarkId id;
+  Eigen::Index offset;                  ///< first row of the landmark block in the stacked state
+  Eigen::Matrix<double, Z, X> J_z_x;    ///< robot block of H (thesis eq. 18)
+  Eigen::Matrix<double, Z, M> J_z_m;    ///< landmark block of H
+  Eigen::Matrix<double, Z, Z> Q;        ///< measurement noise
+  Eigen::Matrix<double, Z, 1> residual; ///< z - h(x, m), wrapped by the model
+};
+
+/// Linearizes `sensor` at robot state x and landmark mean m for measurement z; throws
+/// numerical_error when the model returns NaN or Inf.
+template <class Sensor, class State, class Landmark, class Measurement>
+auto linearize_observation(const Sensor& sensor, const State& x, const Landmark& m, const Measurement& z,
+                           LandmarkId id, Eigen::Index offset) {
+  const auto prediction = sensor.predict(x, m);
+  using Prediction = decltype(prediction);
+  constexpr int Z = decltype(Prediction::z)::RowsAtCompileTime;
+  constexpr int X = decltype(Prediction::J_z_x)::ColsAtCompileTime;
+  constexpr int M = decltype(Prediction::J_z_m)::ColsAtCompileTime;
+  LinearizedObservation<Z, X, M> out{id, offset, prediction.J_z_x, prediction.J_z_m, prediction.Q,
+                                     sensor.residual(z, prediction.z)};
+  if (!out.J_z_x.allFinite() || !out.J_z_m.allFinite() || !out.Q.allFinite() || !out.residual.allFinite())
+    throw numerical_error("measurement model returned NaN or Inf for landmark " + std::to_string(id));
+  return out;
+}
+
+}  // namespace sextant

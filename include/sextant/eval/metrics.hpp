@@ -1,0 +1,82 @@
+#pragma once
+/// \file Accuracy and consistency metrics of the thesis (seed 000, §4.3.1): absolute error
+/// (eqs. 108-109), MAE, RMSE, NEES (eqs. 110-111), ANEES over Monte Carlo runs and chi-square bounds.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "sextant/core/chi_square.hpp"
+#include "sextant/core/error.hpp"
+#include "sextant/core/gaussian.hpp"
+
+namespace sextant::eval {
+
+/// AE = ||estimate - truth|| (eqs. 108, 109).
+template <class A, class B>
+double absolute_error(const Eigen::MatrixBase<A>& estimate, const Eigen::MatrixBase<B>& truth) {
+  return (estimate - truth).norm();
+}
+
+/// NEES = e^T C^-1 e (eqs. 110, 111), by a Cholesky solve; throws numerical_error if C is not PD.
+template <class E, class C>
+double nees(const Eigen::MatrixBase<E>& error, const Eigen::MatrixBase<C>& cov) {
+  return mahalanobis_squared(cholesky_or_throw(cov.eval(), "covariance in NEES"), error);
+}
+
+/// Mean of the values (MAE when they are absolute errors); 0 for an empty range.
+inline double mean(std::span<const double> values) {
+  if (values.empty()) return 0.0;
+  return std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
+}
+
+/// Root mean square of the values (RMSE when they are absolute errors).
+inline double rms(std::span<const double> values) {
+  if (values.empty()) return 0.0;
+  const double sum_sq = std::accumulate(values.begin(), values.end(), 0.0, [](double s, double v) { return s + v * v; });
+  return std::sqrt(sum_sq / static_cast<double>(values.size()));
+}
+
+/// Fraction of values at or below the bound (e.g. share of steps whose NEES is inside 5.991).
+inline double fraction_at_most(std::span<const double> values, double bound) {
+  if (values.empty()) return 0.0;
+  const auto inside = std::count_if(values.begin(), values.end(), [bound](double v) { return v <= bound; });
+  return static_cast<double>(inside) / static_cast<double>(values.size());
+}
+
+/// One-sided upper bound of NEES for `dof` degrees of freedom at `confidence`
+/// (5.991 for 2 dof and 7.815 for 3 dof at 0.95, thesis §4.3.1).
+inline double nees_upper_bound(int dof, double confidence = 0.95) { return chi_square_quantile(dof, confidence); }
+
+/// Two-sided interval of the ANEES (mean NEES over `runs` independent runs) of a consistent
+/// estimator: N * ANEES ~ chi2(N * dof), so the bounds are chi2 quantiles divided by N.
+struct Interval {
+  double lower;
+  double upper;
+  bool contains(double value) const { return value >= lower && value <= upper; }
+};
+inline Interval anees_interval(int dof, int runs, double confidence = 0.95) {
+  if (runs <= 0) throw invalid_input_error("anees_interval needs runs > 0, got " + std::to_string(runs));
+  const double total_dof = static_cast<double>(dof) * runs;
+  const double tail = 0.5 * (1.0 - confidence);
+  return {chi_square_quantile(total_dof, tail) / runs, chi_square_quantile(total_dof, 1.0 - tail) / runs};
+}
+
+/// Per-step ANEES: element-wise mean over runs of per-step NEES series of equal length.
+inline std::vector<double> anees_per_step(const std::vector<std::vector<double>>& nees_per_run) {
+  if (nees_per_run.empty()) return {};
+  const std::size_t steps = nees_per_run.front().size();
+  std::vector<double> out(steps, 0.0);
+  for (const auto& run : nees_per_run) {
+    if (run.size() != steps) throw invalid_input_error("anees_per_step: runs have different lengths");
+    for (std::size_t k = 0; k < steps; ++k) out[k] += run[k];
+  }
+  for (double& v : out) v /= static_cast<double>(nees_per_run.size());
+  return out;
+}
+
+}  // namespace sextant::eval

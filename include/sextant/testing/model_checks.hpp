@@ -1,0 +1,125 @@
+#pragma once
+/// \file Checks any user can run on their own models: every analytic Jacobian against central
+/// differences in the tangent space, and the inverse measurement model against the forward one.
+/// The result converts to bool and carries a readable report of every mismatch.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "sextant/core/concepts.hpp"
+
+namespace sextant::testing {
+
+struct CheckResult {
+  bool passed = true;
+  std::string report;  ///< one line per failed entry: which Jacobian, where, analytic vs numeric
+  explicit operator bool() const { return passed; }
+};
+
+struct CheckOptions {
+  double step = 1e-6;       ///< central-difference step in the tangent space
+  double tolerance = 1e-5;  ///< allowed |analytic - numeric| / max(1, |numeric|)
+};
+
+namespace detail {
+
+template <class A, class N>
+void compare(const std::string& name, const Eigen::MatrixBase<A>& analytic, const Eigen::MatrixBase<N>& numeric,
+             const CheckOptions& options, CheckResult& result) {
+  for (Eigen::Index r = 0; r < numeric.rows(); ++r)
+    for (Eigen::Index c = 0; c < numeric.cols(); ++c) {
+      const double a = analytic(r, c), n = numeric(r, c);
+      if (std::abs(a - n) > options.tolerance * std::max(1.0, std::abs(n)) || !std::isfinite(a)) {
+        std::ostringstream line;
+        line << name << "(" << r << "," << c << "): analytic " << a << " vs numeric " << n << "\n";
+        result.passed = false;
+        result.report += line.str();
+      }
+    }
+}
+
+/// Central difference of f at `base` along each axis of a tangent space of dimension N, where
+/// `shift(base, delta)` moves the argument and f returns a vector compared by `difference`.
+template <int N, class Base, class Shift, class F, class Difference>
+Eigen::MatrixXd central_difference(const Base& base, Shift shift, F f, Difference difference, double step) {
+  const auto center = f(base);
+  Eigen::MatrixXd out(difference(center, center).size(), N);
+  for (int i = 0; i < N; ++i) {
+    Eigen::Matrix<double, N, 1> delta = Eigen::Matrix<double, N, 1>::Zero();
+    delta(i) = step;
+    const auto forward = f(shift(base, delta));
+    const auto backward = f(shift(base, (-delta).eval()));
+    out.col(i) = (difference(forward, center) - difference(backward, center)) / (2.0 * step);
+  }
+  return out;
+}
+
+}  // namespace detail
+
+/// Checks MotionPrediction::J_x_x of `model` at (x, u, dt): J = d minus(g(plus(x, d)), g(x)) / d d.
+template <class Motion>
+  requires MotionModel<Motion>
+CheckResult check_motion_jacobians(const Motion& model, const typename Motion::State& x,
+                                   const typename Motion::Control& u, double dt, CheckOptions options = {}) {
+  using Space = typename Motion::Space;
+  CheckResult result;
+  const auto numeric = detail::central_difference<Motion::kDim>(
+      x, [](const auto& s, const auto& d) { return Space::plus(s, d); },
+      [&](const auto& s) { return model.predict(s, u, dt).x; },
+      [](const auto& a, const auto& b) { return Space::minus(a, b); }, options.step);
+  detail::compare("J_x_x", model.predict(x, u, dt).J_x_x, numeric, options, result);
+  return result;
+}
+
+/// Checks J_z_x and J_z_m of predict(x, m), and J_m_x and J_m_z of initialize(x, z), and that
+/// predict(x, initialize(x, z).m) reproduces z.
+/// Call as check_measurement_jacobians<MyMotion>(sensor, x, m).
+template <class Motion, class Sensor>
+  requires MeasurementModelFor<Sensor, Motion>
+CheckResult check_measurement_jacobians(const Sensor& sensor, const typename Motion::State& x,
+                                        const typename Sensor::Landmark& m, CheckOptions options = {}) {
+  using Space = typename Motion::Space;
+  using Landmark = typename Sensor::Landmark;
+  using Measurement = typename Sensor::Measurement;
+  constexpr int M = landmark_dim_v<Sensor>, Z = measurement_dim_v<Sensor>;
+  const auto euclidean_shift = [](const auto& v, const auto& d) { return (v + d).eval(); };
+  const auto euclidean_difference = [](const auto& a, const auto& b) { return (a - b).eval(); };
+  const auto measurement_difference = [&](const auto& a, const auto& b) { return sensor.residual(a, b); };
+  CheckResult result;
+
+  const auto prediction = sensor.predict(x, m);
+  detail::compare("J_z_x", prediction.J_z_x,
+                  detail::central_difference<Motion::kDim>(
+                      x, [](const auto& s, const auto& d) { return Space::plus(s, d); },
+                      [&](const auto& s) { return Measurement(sensor.predict(s, m).z); }, measurement_difference,
+                      options.step),
+                  options, result);
+  detail::compare("J_z_m", prediction.J_z_m,
+                  detail::central_difference<M>(
+                      m, euclidean_shift, [&](const Landmark& l) { return Measurement(sensor.predict(x, l).z); },
+                      measurement_difference, options.step),
+                  options, result);
+
+  const Measurement z = prediction.z;
+  const auto init = sensor.initialize(x, z);
+  detail::compare("J_m_x", init.J_m_x,
+                  detail::central_difference<Motion::kDim>(
+                      x, [](const auto& s, const auto& d) { return Space::plus(s, d); },
+                      [&](const auto& s) { return Landmark(sensor.initialize(s, z).m); }, euclidean_difference,
+                      options.step),
+                  options, result);
+  detail::compare("J_m_z", init.J_m_z,
+                  detail::central_difference<Z>(
+                      z, euclidean_shift, [&](const Measurement& w) { return Landmark(sensor.initialize(x, w).m); },
+                      euclidean_difference, options.step),
+                  options, result);
+  const auto round_trip = sensor.residual(Measurement(sensor.predict(x, init.m).z), z);
+  detail::compare("inverse model: residual(predict(x, initialize(x, z)), z)", round_trip,
+                  Eigen::Matrix<double, Z, 1>::Zero(), options, result);
+  return result;
+}
+
+}  // namespace sextant::testing

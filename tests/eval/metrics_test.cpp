@@ -1,0 +1,45 @@
+#include "sextant/eval/metrics.hpp"
+
+#include <gtest/gtest.h>
+
+namespace sextant::eval {
+namespace {
+
+TEST(Metrics, ChiSquareBoundsOfTheThesis) {
+  EXPECT_NEAR(nees_upper_bound(2), 5.991, 5e-4);  // thesis §4.3.1, 2 dof
+  EXPECT_NEAR(nees_upper_bound(3), 7.815, 5e-4);  // 3 dof
+  EXPECT_NEAR(nees_upper_bound(1, 0.99), 6.635, 5e-4);
+  EXPECT_THROW(nees_upper_bound(0), invalid_input_error);
+  EXPECT_THROW(nees_upper_bound(2, 1.0), invalid_input_error);
+}
+
+TEST(Metrics, AneesIntervalForNRuns) {
+  // 50 runs of a 2-dof estimate: 100 dof, chi2_100 quantiles 74.22 and 129.56, divided by 50.
+  const Interval interval = anees_interval(2, 50);
+  EXPECT_NEAR(interval.lower, 74.2219 / 50, 1e-4);
+  EXPECT_NEAR(interval.upper, 129.5612 / 50, 1e-4);
+  EXPECT_TRUE(interval.contains(2.0));
+  EXPECT_FALSE(interval.contains(2.7));
+  EXPECT_THROW(anees_interval(2, 0), invalid_input_error);
+}
+
+TEST(Metrics, AbsoluteErrorNeesMaeRmse) {
+  EXPECT_DOUBLE_EQ(absolute_error(Eigen::Vector2d(3.0, 4.0), Eigen::Vector2d::Zero()), 5.0);
+  const Eigen::Matrix2d cov = Eigen::Vector2d(4.0, 1.0).asDiagonal();
+  EXPECT_DOUBLE_EQ(nees(Eigen::Vector2d(2.0, 1.0), cov), 2.0);
+  EXPECT_THROW(nees(Eigen::Vector2d(1.0, 1.0), Eigen::Matrix2d::Zero()), numerical_error);
+  const std::vector<double> errors{1.0, 2.0, 2.0, 3.0};
+  EXPECT_DOUBLE_EQ(mean(errors), 2.0);
+  EXPECT_DOUBLE_EQ(rms(errors), std::sqrt(4.5));
+  EXPECT_DOUBLE_EQ(fraction_at_most(errors, 2.0), 0.75);
+  EXPECT_EQ(mean({}), 0.0);
+}
+
+TEST(Metrics, AneesPerStepAveragesRuns) {
+  const auto anees = anees_per_step({{1.0, 2.0, 3.0}, {3.0, 4.0, 5.0}});
+  EXPECT_EQ(anees, (std::vector<double>{2.0, 3.0, 4.0}));
+  EXPECT_THROW(anees_per_step({{1.0}, {1.0, 2.0}}), invalid_input_error);
+}
+
+}  // namespace
+}  // namespace sextant::eval
