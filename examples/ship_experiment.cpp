@@ -33,11 +33,9 @@ RunSummary evaluate(Backend& backend, const sim::Ship2DDataset& data) {
     out.seconds.push_back(record.steps[k].seconds);
     out.trajectory.push_back(pose.mean);
   }
-  for (const auto& landmark : backend.map()) {
-    const Eigen::Vector2d error = landmark.mean - data.true_landmarks.at(landmark.id);
-    out.map_error.push_back(error.norm());
-    out.map_nees.push_back(eval::nees(error, landmark.cov));
-  }
+  auto map = eval::evaluate_map(backend.map(), data.true_landmarks);
+  out.map_error = std::move(map.errors);
+  out.map_nees = std::move(map.nees);
   out.total_seconds = record.total_seconds;
   return out;
 }

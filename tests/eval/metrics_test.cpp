@@ -41,5 +41,17 @@ TEST(Metrics, AneesPerStepAveragesRuns) {
   EXPECT_THROW(anees_per_step({{1.0}, {1.0, 2.0}}), invalid_input_error);
 }
 
+TEST(Metrics, EvaluateMapPerLandmark) {
+  const std::vector<LandmarkEstimate<2>> map{{4, Eigen::Vector2d(3.0, 4.0), Eigen::Matrix2d::Identity()},
+                                             {9, Eigen::Vector2d(1.0, 1.0), 4.0 * Eigen::Matrix2d::Identity()}};
+  const std::map<LandmarkId, Eigen::Vector2d> truth{{4, Eigen::Vector2d::Zero()}, {9, Eigen::Vector2d(1.0, 3.0)}};
+  const auto evaluation = evaluate_map(map, truth);
+  EXPECT_EQ(evaluation.ids, (std::vector<LandmarkId>{4, 9}));
+  EXPECT_EQ(evaluation.errors, (std::vector<double>{5.0, 2.0}));
+  EXPECT_EQ(evaluation.nees, (std::vector<double>{25.0, 1.0}));
+  EXPECT_THROW(evaluate_map(map, std::map<LandmarkId, Eigen::Vector2d>{{4, Eigen::Vector2d::Zero()}}),
+               unknown_landmark_error);
+}
+
 }  // namespace
 }  // namespace sextant::eval

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <span>
 #include <string>
@@ -76,6 +77,30 @@ inline std::vector<double> anees_per_step(const std::vector<std::vector<double>>
     for (std::size_t k = 0; k < steps; ++k) out[k] += run[k];
   }
   for (double& v : out) v /= static_cast<double>(nees_per_run.size());
+  return out;
+}
+
+/// Per-landmark accuracy and consistency of a map against ground truth (eqs. 109, 111).
+struct MapEvaluation {
+  std::vector<LandmarkId> ids;      ///< landmarks of the estimate, in its order
+  std::vector<double> errors;       ///< AE per landmark
+  std::vector<double> nees;         ///< NEES per landmark
+};
+
+/// Evaluates every estimated landmark against `truth`; throws unknown_landmark_error when the
+/// estimate holds a landmark that the ground truth does not.
+template <int M, class Truth>
+MapEvaluation evaluate_map(const std::vector<LandmarkEstimate<M>>& map, const std::map<LandmarkId, Truth>& truth) {
+  MapEvaluation out;
+  for (const auto& landmark : map) {
+    const auto it = truth.find(landmark.id);
+    if (it == truth.end())
+      throw unknown_landmark_error("landmark " + std::to_string(landmark.id) + " has no ground truth");
+    const Eigen::Matrix<double, M, 1> error = landmark.mean - it->second;
+    out.ids.push_back(landmark.id);
+    out.errors.push_back(error.norm());
+    out.nees.push_back(nees(error, landmark.cov));
+  }
   return out;
 }
 
