@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <string>
 #include <unordered_map>
+#include <span>
 #include <vector>
 
 #include "sextant/core/error.hpp"
@@ -55,5 +56,22 @@ class LandmarkPool {
   std::unordered_map<LandmarkId, std::size_t> slots_;
   std::vector<LandmarkId> ids_;
 };
+
+/// Observations split into those of landmarks the pool holds and those of new landmarks, each in
+/// the order given.
+template <class Measurement>
+struct SplitObservations {
+  std::vector<Observation<Measurement>> known;
+  std::vector<Observation<Measurement>> fresh;
+};
+
+template <class Measurement>
+SplitObservations<Measurement> split_known_and_new(const LandmarkPool& pool,
+                                                   std::span<const Observation<Measurement>> observations) {
+  SplitObservations<Measurement> out;
+  for (const auto& observation : observations)
+    (pool.contains(observation.landmark_id) ? out.known : out.fresh).push_back(observation);
+  return out;
+}
 
 }  // namespace sextant

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "sextant/core/chi_square.hpp"
+#include "sextant/core/landmark_init.hpp"
 #include "sextant/core/validation.hpp"
 
 namespace sextant {
@@ -40,9 +41,7 @@ void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
 template <class Motion, class Sensor>
 UpdateResult EkfSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
   require_valid_observations(observations);
-  std::vector<ObservationType> known, fresh;
-  for (const auto& observation : observations)
-    (pool_.contains(observation.landmark_id) ? known : fresh).push_back(observation);
+  const auto [known, fresh] = split_known_and_new(pool_, observations);
   UpdateResult result;
   if (options_.batch_update || known.size() <= 1) {
     commit(plan(known, fresh, result));
@@ -161,11 +160,8 @@ auto EkfSlam<Motion, Sensor>::plan(std::span<const ObservationType> known, std::
     result.corrected += observations.size();
   }
   for (const auto& observation : fresh) {
-    const Init init = sensor_.initialize(x_after, observation.z);
-    if (!init.m.allFinite() || !init.J_m_x.allFinite() || !init.J_m_z.allFinite() || !init.Q.allFinite())
-      throw numerical_error("inverse measurement model returned NaN or Inf for landmark " +
-                            std::to_string(observation.landmark_id));
-    out.new_landmarks.emplace_back(observation.landmark_id, init);
+    out.new_landmarks.emplace_back(observation.landmark_id,
+                                   initialize_landmark(sensor_, x_after, observation.z, observation.landmark_id));
   }
   result.initialized += out.new_landmarks.size();
   return out;

@@ -1,0 +1,380 @@
+#pragma once
+// Bodies of SeifSlam (see ../seif_slam.hpp).
+
+#include <Eigen/LU>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <string>
+#include <unordered_set>
+#include <utility>
+
+#include "sextant/core/landmark_init.hpp"
+#include "sextant/core/validation.hpp"
+
+namespace sextant {
+
+template <class Motion, class Sensor>
+SeifSlam<Motion, Sensor>::SeifSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, SeifOptions options)
+    : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), x_(prior.mean) {
+  if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
+  const auto llt = cholesky_or_throw(prior.cov, "prior covariance");
+  info_.robot() = symmetrized(llt.solve(Eigen::Matrix<double, X, X>::Identity()));
+  if (options_.mean_recovery_sweeps < 0 || options_.exact_recovery_period < 0)
+    throw invalid_input_error("SeifOptions: mean_recovery_sweeps and exact_recovery_period must be >= 0");
+}
+
+/// Thesis eqs. (20)-(26) in error-state form, with Phi = G^-T Omega G^-1 and
+/// T = (R^-1 + Phi_xx)^-1 = (I + R Phi_xx)^-1 R (no R^-1 needed):
+///   Omega_xx' = (I - Phi_xx T) Phi_xx,  Omega_xj' = (I - Phi_xx T) Phi_xj,  Omega_ij' = Omega_ij - Phi_xi^T T Phi_xj,
+///   r_x' = (I - Phi_xx T) G^-T r_x,     r_j' = r_j - Phi_xj^T T G^-T r_x,
+/// for the active landmarks i, j only; everything else is untouched.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
+  using MatrixX = Eigen::Matrix<double, X, X>;
+  require_finite(u, "control");
+  require_positive_time_step(dt);
+  const auto prediction = motion_.predict(x_, u, dt);
+  if (!Space::is_finite(prediction.x) || !prediction.J_x_x.allFinite() || !prediction.R.allFinite())
+    throw numerical_error("motion model returned NaN or Inf");
+  const auto singular_values = Eigen::JacobiSVD<MatrixX>(prediction.J_x_x).singularValues();
+  if (!(singular_values(X - 1) > 1e-12 * singular_values(0)))
+    throw numerical_error("motion Jacobian G is singular; the SEIF motion update needs G^-1");
+  const MatrixX G_inv_T = prediction.J_x_x.partialPivLu().inverse().transpose();  // X x X, conditioning checked above
+  const MatrixX Phi_xx = symmetrized(G_inv_T * info_.robot() * G_inv_T.transpose());
+  const MatrixX T = symmetrized(
+      (MatrixX::Identity() + prediction.R * Phi_xx).partialPivLu().solve(prediction.R));
+  const MatrixX A = MatrixX::Identity() - Phi_xx * T;
+  std::vector<std::pair<std::size_t, Eigen::Matrix<double, X, M>>> Phi_x;  // Phi_xj of the active landmarks
+  Phi_x.reserve(info_.robot_links().size());
+  for (const auto& [slot, block] : info_.robot_links()) Phi_x.emplace_back(slot, G_inv_T * block);
+  const Eigen::Matrix<double, X, 1> r_x = G_inv_T * info_.robot_residual();
+
+  info_.robot() = symmetrized(A * Phi_xx);
+  info_.robot_residual() = A * r_x;
+  const Eigen::Matrix<double, X, 1> T_r_x = T * r_x;
+  for (std::size_t a = 0; a < Phi_x.size(); ++a) {
+    const auto& [i, Phi_xi] = Phi_x[a];
+    info_.set_robot_link(i, A * Phi_xi);
+    const Eigen::Matrix<double, M, X> Phi_ix_T = Phi_xi.transpose() * T;
+    info_.diagonal(i) = symmetrized(info_.diagonal(i) - Phi_ix_T * Phi_xi);
+    info_.landmark_residual(i) -= Phi_xi.transpose() * T_r_x;
+    for (std::size_t b = a + 1; b < Phi_x.size(); ++b) info_.add_to_link(i, Phi_x[b].first, -Phi_ix_T * Phi_x[b].second);
+  }
+  x_ = prediction.x;
+  touch();
+}
+
+/// H^T Q^-1 H and H^T Q^-1 nu of one observation, by blocks (thesis eqs. 29-30).
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::measurement_information(const ObservationType& observation) const
+    -> MeasurementInformation {
+  const std::size_t slot = pool_.slot(observation.landmark_id);
+  const Linearized lin = linearize_observation(sensor_, x_, landmark_mean(slot), observation.z,
+                                               observation.landmark_id, offset_of(slot));
+  const auto llt = cholesky_or_throw(lin.Q, "measurement noise Q of landmark " + std::to_string(observation.landmark_id));
+  const Eigen::Matrix<double, Z, X> W_Hx = llt.solve(lin.J_z_x);
+  const Eigen::Matrix<double, Z, M> W_Hm = llt.solve(lin.J_z_m);
+  const Eigen::Matrix<double, Z, 1> W_nu = llt.solve(lin.residual);
+  return {slot,
+          symmetrized(lin.J_z_x.transpose() * W_Hx),
+          lin.J_z_x.transpose() * W_Hm,
+          symmetrized(lin.J_z_m.transpose() * W_Hm),
+          lin.J_z_x.transpose() * W_nu,
+          lin.J_z_m.transpose() * W_nu};
+}
+
+/// A new landmark in information form: the conditional m = init.m + J_m_x dx + v, v ~ N(0, C),
+/// C = J_m_z Q J_m_z^T, adds [J_m_x^T W J_m_x, -J_m_x^T W; -W J_m_x, W] with W = C^-1 and no residual.
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::new_landmark(const ObservationType& observation) const -> NewLandmark {
+  const Init init = initialize_landmark(sensor_, x_, observation.z, observation.landmark_id);
+  const Eigen::Matrix<double, M, M> C = symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose());
+  const auto llt = cholesky_or_throw(
+      C, "covariance J_m_z Q J_m_z^T of new landmark " + std::to_string(observation.landmark_id));
+  const Eigen::Matrix<double, M, M> W = symmetrized(llt.solve(Eigen::Matrix<double, M, M>::Identity()));
+  return {observation.landmark_id, init.m, symmetrized(init.J_m_x.transpose() * W * init.J_m_x),
+          -init.J_m_x.transpose() * W, W};
+}
+
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::add(const MeasurementInformation& info) {
+  info_.robot() += info.xx;
+  info_.add_to_robot_link(info.slot, info.xm);
+  info_.diagonal(info.slot) += info.mm;
+  info_.robot_residual() += info.r_x;
+  info_.landmark_residual(info.slot) += info.r_m;
+}
+
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::augment(const NewLandmark& landmark) {
+  const std::size_t slot = pool_.add(landmark.id);
+  info_.append_landmark();
+  landmark_means_.conservativeResize(landmark_means_.size() + M);
+  landmark_means_.template tail<M>() = landmark.mean;
+  info_.robot() += landmark.xx;
+  info_.add_to_robot_link(slot, landmark.xm);
+  info_.diagonal(slot) = landmark.mm;
+}
+
+template <class Motion, class Sensor>
+UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
+  require_valid_observations(observations);
+  const auto [known, fresh] = split_known_and_new(pool_, observations);
+  // Everything that can throw on bad input, before the state changes.
+  std::vector<MeasurementInformation> measurements;
+  measurements.reserve(known.size());
+  for (const auto& observation : known) measurements.push_back(measurement_information(observation));
+  std::vector<NewLandmark> landmarks;
+  landmarks.reserve(fresh.size());
+  for (const auto& observation : fresh) landmarks.push_back(new_landmark(observation));
+
+  std::vector<std::size_t> observed;
+  for (const auto& info : measurements) {
+    add(info);
+    observed.push_back(info.slot);
+  }
+  for (const auto& landmark : landmarks) {
+    augment(landmark);
+    observed.push_back(pool_.size() - 1);
+  }
+  touch();
+  ++updates_;
+  if (options_.exact_recovery_period > 0 && updates_ % static_cast<std::uint64_t>(options_.exact_recovery_period) == 0)
+    recover_mean_exactly();
+  else
+    recover_mean_locally();
+  update_active_queue(observed);
+  sparsify();
+  touch();
+  return {known.size(), fresh.size(), {}};
+}
+
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::recover_mean_locally() {
+  for (int sweep = 0; sweep < options_.mean_recovery_sweeps; ++sweep) {
+    if (options_.mean_recovery == MeanRecovery::active_block)
+      recover_mean_of_active_block();
+    else
+      recover_mean_by_coordinate_descent();
+  }
+}
+
+/// Omega restricted to (robot, slots...) as a dense matrix.
+template <class Motion, class Sensor>
+Eigen::MatrixXd SeifSlam<Motion, Sensor>::robot_and_landmarks_block(const std::vector<std::size_t>& slots) const {
+  const Eigen::Index d = X + M * static_cast<Eigen::Index>(slots.size());
+  auto at = [](std::size_t k) { return X + M * static_cast<Eigen::Index>(k); };
+  Eigen::MatrixXd D(d, d);
+  D.template topLeftCorner<X, X>() = info_.robot();
+  for (std::size_t a = 0; a < slots.size(); ++a) {
+    D.template block<X, M>(0, at(a)) = info_.robot_link(slots[a]);
+    D.template block<M, X>(at(a), 0) = info_.robot_link(slots[a]).transpose();
+    for (std::size_t b = 0; b < slots.size(); ++b)
+      D.template block<M, M>(at(a), at(b)) = info_.landmark_block(slots[a], slots[b]);
+  }
+  return D;
+}
+
+/// Solves Omega_BB delta_B = r_B for B = robot + active landmarks, moves their means, and passes
+/// the change on to the residuals of their passive neighbours: r_b -= Omega_bB delta_B.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::recover_mean_of_active_block() {
+  std::vector<std::size_t> slots;
+  for (const auto& [slot, block] : info_.robot_links()) slots.push_back(slot);
+  const Eigen::MatrixXd D = robot_and_landmarks_block(slots);
+  Eigen::VectorXd r(D.rows());
+  r.template head<X>() = info_.robot_residual();
+  for (std::size_t a = 0; a < slots.size(); ++a) r.template segment<M>(X + M * a) = info_.landmark_residual(slots[a]);
+  const Eigen::VectorXd delta = cholesky_or_throw(D, "information of the robot and the active landmarks").solve(r);
+  const Eigen::VectorXd r_after = r - D * delta;
+  x_ = Space::plus(x_, delta.template head<X>());
+  info_.robot_residual() = r_after.template head<X>();
+  std::unordered_set<std::size_t> in_block(slots.begin(), slots.end());
+  for (std::size_t a = 0; a < slots.size(); ++a) {
+    const Eigen::Matrix<double, M, 1> dm = delta.template segment<M>(X + M * a);
+    landmark_means_.template segment<M>(M * slots[a]) += dm;
+    info_.landmark_residual(slots[a]) = r_after.template segment<M>(X + M * a);
+    for (const auto& [neighbour, block] : info_.links(slots[a]))
+      if (!in_block.contains(neighbour)) info_.landmark_residual(neighbour) -= block.transpose() * dm;
+  }
+}
+
+/// Block coordinate descent on Omega delta = r over the robot and the active landmarks
+/// (thesis eqs. 31-36): delta_a = Omega_aa^-1 r_a, mu_a <- mu_a + delta_a, r_b -= Omega_ba delta_a.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::recover_mean_by_coordinate_descent() {
+  const auto robot_llt = cholesky_or_throw(info_.robot(), "robot block of the information matrix");
+  std::vector<std::pair<std::size_t, Eigen::LLT<Eigen::Matrix<double, M, M>>>> active;
+  for (const auto& [slot, block] : info_.robot_links())
+    active.emplace_back(slot, cholesky_or_throw(info_.diagonal(slot), "information block of an active landmark"));
+  {
+    const Eigen::Matrix<double, X, 1> dx = robot_llt.solve(info_.robot_residual());
+    x_ = Space::plus(x_, dx);
+    info_.robot_residual() -= info_.robot() * dx;
+    for (const auto& [slot, block] : info_.robot_links()) info_.landmark_residual(slot) -= block.transpose() * dx;
+    for (const auto& [slot, llt] : active) {
+      const Eigen::Matrix<double, M, 1> dm = llt.solve(info_.landmark_residual(slot));
+      landmark_means_.template segment<M>(M * slot) += dm;
+      info_.landmark_residual(slot) -= info_.diagonal(slot) * dm;
+      info_.robot_residual() -= info_.robot_link(slot) * dm;
+      for (const auto& [neighbour, block] : info_.links(slot)) info_.landmark_residual(neighbour) -= block.transpose() * dm;
+    }
+  }
+}
+
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::recover_mean_exactly() {
+  const Eigen::SparseMatrix<double> omega = info_.to_sparse();
+  const Factor factor(omega);
+  if (factor.info() != Eigen::Success) throw numerical_error("information matrix is not positive definite");
+  const Eigen::VectorXd r = info_.residual();
+  const Eigen::VectorXd delta = factor.solve(r);
+  if (!delta.allFinite()) throw numerical_error("exact mean recovery is not finite");
+  x_ = Space::plus(x_, delta.template head<X>());
+  landmark_means_ += delta.tail(delta.size() - X);
+  info_.set_residual(r - omega * delta);
+  touch();
+}
+
+/// The thesis's queue (§3.5.4): landmarks observed now first, then the previously active ones in
+/// their previous order.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::update_active_queue(const std::vector<std::size_t>& observed_slots) {
+  std::vector<std::size_t> queue;
+  std::unordered_set<std::size_t> queued;
+  auto push = [&](std::size_t slot) {
+    if (info_.is_linked_to_robot(slot) && queued.insert(slot).second) queue.push_back(slot);
+  };
+  for (std::size_t slot : observed_slots) push(slot);
+  for (std::size_t slot : active_queue_) push(slot);
+  for (const auto& [slot, block] : info_.robot_links()) push(slot);
+  active_queue_ = std::move(queue);
+}
+
+namespace detail {
+/// D with the variables at `eliminate` (block start, size) marginalized out: the Schur complement,
+/// written back into a matrix of the same size whose eliminated rows and columns are zero.
+inline Eigen::MatrixXd marginalize_dense(const Eigen::MatrixXd& D, const std::vector<Eigen::Index>& eliminate,
+                                         const std::string& what) {
+  const Eigen::Index n = D.rows();
+  std::vector<bool> gone(n, false);
+  for (Eigen::Index i : eliminate) gone[i] = true;
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (!gone[i]) keep.push_back(i);
+  const Eigen::MatrixXd D_kk = D(keep, keep), D_ke = D(keep, eliminate), D_ee = D(eliminate, eliminate);
+  const auto llt = cholesky_or_throw(D_ee, what);
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, n);
+  out(keep, keep) = D_kk - D_ke * llt.solve(D_ke.transpose());
+  return out;
+}
+}  // namespace detail
+
+/// Thesis eqs. (39)-(43), Appendix A: with B = (x, m+, m0) and D = Omega_BB,
+///   Omega~ - Omega = Omega1 - Omega2 - D_Bx D_xx^-1 D_xB on B,
+/// Omega1 = D with m0 marginalized, Omega2 = D with x and m0 marginalized. The residual r is
+/// unchanged: r~ = xi~ - Omega~ mu = xi + (Omega~ - Omega) mu - Omega~ mu = r (eq. 44).
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::sparsify() {
+  if (options_.max_active == 0 || active_queue_.size() <= options_.max_active) return;
+  const std::vector<std::size_t>& block_slots = active_queue_;  // m+ = first max_active, m0 = the rest
+  const std::size_t kept = options_.max_active;
+  const Eigen::Index d = X + M * static_cast<Eigen::Index>(block_slots.size());
+  auto at = [](std::size_t k) { return X + M * static_cast<Eigen::Index>(k); };
+  const Eigen::MatrixXd D = robot_and_landmarks_block(block_slots);
+  std::vector<Eigen::Index> robot, dropped;
+  for (Eigen::Index i = 0; i < X; ++i) robot.push_back(i);
+  for (Eigen::Index i = at(kept); i < d; ++i) dropped.push_back(i);
+  std::vector<Eigen::Index> robot_and_dropped = robot;
+  robot_and_dropped.insert(robot_and_dropped.end(), dropped.begin(), dropped.end());
+  const Eigen::MatrixXd omega1 = detail::marginalize_dense(D, dropped, "information of the landmarks to deactivate");
+  const Eigen::MatrixXd omega2 =
+      detail::marginalize_dense(D, robot_and_dropped, "information of the robot and the landmarks to deactivate");
+  const auto robot_llt = cholesky_or_throw(info_.robot(), "robot block of the information matrix");
+  const Eigen::MatrixXd D_xB = D.topRows(X);
+  const Eigen::MatrixXd delta = omega1 - omega2 - D_xB.transpose() * robot_llt.solve(D_xB);
+
+  info_.robot() = symmetrized(info_.robot() + delta.template topLeftCorner<X, X>());
+  for (std::size_t a = 0; a < block_slots.size(); ++a) {
+    const std::size_t i = block_slots[a];
+    if (a < kept)
+      info_.add_to_robot_link(i, delta.template block<X, M>(0, at(a)));
+    else
+      info_.remove_robot_link(i);
+    info_.diagonal(i) = symmetrized(info_.diagonal(i) + delta.template block<M, M>(at(a), at(a)));
+    for (std::size_t b = a + 1; b < block_slots.size(); ++b)
+      info_.add_to_link(i, block_slots[b], delta.template block<M, M>(at(a), at(b)));
+  }
+  active_queue_.resize(kept);
+}
+
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
+  const std::size_t slot = pool_.slot(id);
+  info_.marginalize_landmark(slot);  // throws before changing anything
+  const auto removal = pool_.remove(id);
+  landmark_means_.template segment<M>(M * removal.freed_slot) = landmark_means_.template segment<M>(M * removal.last_slot);
+  landmark_means_.conservativeResize(landmark_means_.size() - M);
+  std::vector<std::size_t> queue;
+  for (std::size_t s : active_queue_)
+    if (s != removal.freed_slot) queue.push_back(s == removal.last_slot ? removal.freed_slot : s);
+  active_queue_ = std::move(queue);
+  update_active_queue({});
+  touch();
+}
+
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::factorization() const -> const Factor& {
+  if (!factor_ || factor_revision_ != revision_) {
+    factor_ = std::make_shared<const Factor>(info_.to_sparse());
+    factor_revision_ = revision_;
+  }
+  if (factor_->info() != Eigen::Success) throw numerical_error("information matrix is not positive definite");
+  return *factor_;
+}
+
+/// A diagonal block of Omega^-1 from `size` sparse solves.
+template <class Motion, class Sensor>
+Eigen::MatrixXd SeifSlam<Motion, Sensor>::marginal_covariance(Eigen::Index offset, Eigen::Index size) const {
+  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(state_dim(), size);
+  unit.block(offset, 0, size, size).setIdentity();
+  const Eigen::MatrixXd columns = factorization().solve(unit);
+  return symmetrized(columns.block(offset, 0, size, size));
+}
+
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::pose() const -> PoseEstimate {
+  return {x_, marginal_covariance(0, X)};
+}
+
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::landmark(LandmarkId id) const -> LandmarkEstimate<M> {
+  const std::size_t slot = pool_.slot(id);
+  return {id, landmark_mean(slot), marginal_covariance(offset_of(slot), M)};
+}
+
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::map() const -> MapEstimate {
+  MapEstimate out;
+  out.reserve(pool_.size());
+  constexpr std::size_t kChunk = 32;  // landmarks per multi-right-hand-side solve
+  for (std::size_t first = 0; first < pool_.size(); first += kChunk) {
+    const std::size_t count = std::min(kChunk, pool_.size() - first);
+    Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(state_dim(), M * static_cast<Eigen::Index>(count));
+    unit.block(offset_of(first), 0, unit.cols(), unit.cols()).setIdentity();
+    const Eigen::MatrixXd columns = factorization().solve(unit);
+    for (std::size_t k = 0; k < count; ++k)
+      out.push_back({pool_.id_at(first + k), landmark_mean(first + k),
+                     symmetrized(columns.template block<M, M>(offset_of(first + k), M * k))});
+  }
+  return out;
+}
+
+template <class Motion, class Sensor>
+std::vector<LandmarkId> SeifSlam<Motion, Sensor>::active_landmarks() const {
+  std::vector<LandmarkId> out;
+  for (std::size_t slot : active_queue_) out.push_back(pool_.id_at(slot));
+  return out;
+}
+
+}  // namespace sextant

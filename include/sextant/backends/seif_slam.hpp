@@ -1,0 +1,153 @@
+#pragma once
+/// \file SEIF-SLAM, the sparse extended information filter (thesis §3.5, Appendix A; Thrun et al.;
+/// Eustice et al.), for any motion and measurement model pair.
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "sextant/core/concepts.hpp"
+#include "sextant/core/gaussian.hpp"
+#include "sextant/core/landmark_pool.hpp"
+#include "sextant/core/linearized_observation.hpp"
+#include "sextant/core/sparse_information.hpp"
+#include "sextant/core/update_result.hpp"
+
+namespace sextant {
+
+/// How the mean of the robot and the active landmarks is recovered after each update.
+enum class MeanRecovery {
+  /// One joint solve of Omega_BB delta_B = r_B over B = robot + active landmarks (passive ones held
+  /// fixed): one block coordinate-descent step with the whole active neighbourhood as the block.
+  active_block,
+  /// The thesis's coordinate descent (eqs. 33-36): the robot, then each active landmark in turn.
+  coordinate_descent,
+};
+
+struct SeifOptions {
+  std::size_t max_active = 0;     ///< landmarks kept linked to the robot by sparsification; 0 = no sparsification
+  MeanRecovery mean_recovery = MeanRecovery::active_block;
+  int mean_recovery_sweeps = 1;   ///< sweeps per update (0 = none)
+  int exact_recovery_period = 0;  ///< every K updates, an exact sparse solve of the whole mean; 0 = never
+};
+
+/// SEIF-SLAM in error-state information form: Omega (block-sparse) and r = xi - Omega mu at the
+/// current mean mu. The motion update touches the robot and the active landmarks only (eqs. 20-26,
+/// by the matrix inversion lemma); a measurement adds H^T Q^-1 H and H^T Q^-1 nu (eqs. 27-30); the
+/// mean of the robot and the active landmarks is recovered by coordinate descent (eqs. 31-36);
+/// sparsification keeps at most max_active landmarks linked to the robot (eqs. 37-44, Appendix A).
+/// Covariances are computed on demand by sparse Cholesky solves, never by inverting Omega.
+template <class Motion, class Sensor>
+class SeifSlam {
+  static_assert(MotionModel<Motion>,
+                "SeifSlam<Motion, Sensor>: Motion must satisfy sextant::MotionModel (types State, Control, Space, "
+                "constant kDim, and predict(x, u, dt) returning MotionPrediction<State, kDim>)");
+  static_assert(MeasurementModelFor<Sensor, Motion>,
+                "SeifSlam<Motion, Sensor>: Sensor must satisfy sextant::MeasurementModelFor<Sensor, Motion> (fixed-size "
+                "Eigen Landmark and Measurement, predict(x, m) -> MeasurementPrediction, residual(z, z_hat), "
+                "initialize(x, z) -> LandmarkInit)");
+
+ public:
+  using State = typename Motion::State;
+  using Control = typename Motion::Control;
+  using Space = typename Motion::Space;
+  using Landmark = typename Sensor::Landmark;
+  using Measurement = typename Sensor::Measurement;
+  using ObservationType = Observation<Measurement>;
+  static constexpr int X = Motion::kDim;
+  static constexpr int M = landmark_dim_v<Sensor>;
+  static constexpr int Z = measurement_dim_v<Sensor>;
+  using PoseEstimate = Gaussian<State, X>;
+  using MapEstimate = std::vector<LandmarkEstimate<M>>;
+
+  SeifSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, SeifOptions options = {});
+
+  /// Motion update (eqs. 20-26). Throws invalid_input_error on NaN/Inf or dt <= 0, numerical_error
+  /// when the motion Jacobian is singular; the state is then unchanged.
+  void predict(const Control& u, double dt);
+
+  /// Measurement update, new landmarks, mean recovery and sparsification. Bad input (NaN/Inf,
+  /// repeated ids, non-PD noise) throws before anything changes.
+  UpdateResult update(std::span<const ObservationType> observations);
+  UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }
+
+  /// Marginalizes a landmark out of the information form (thesis Appendix C).
+  void remove_landmark(LandmarkId id);
+
+  /// Solves Omega delta = r exactly (sparse Cholesky) and moves the whole mean to it.
+  void recover_mean_exactly();
+
+  /// Pose mean (as recovered) with its marginal covariance by a sparse solve.
+  PoseEstimate pose() const;
+  LandmarkEstimate<M> landmark(LandmarkId id) const;
+  MapEstimate map() const;
+  bool has_landmark(LandmarkId id) const { return pool_.contains(id); }
+  std::size_t num_landmarks() const { return pool_.size(); }
+  const std::vector<LandmarkId>& landmark_ids() const { return pool_.ids(); }
+  Eigen::Index state_dim() const { return info_.dim(); }
+  /// Ids of the landmarks linked to the robot, most recently observed first.
+  std::vector<LandmarkId> active_landmarks() const;
+  /// The information matrix, ordered (robot, landmarks in slot order).
+  Eigen::SparseMatrix<double> information_matrix() const { return info_.to_sparse(); }
+  const SparseInformation<X, M>& information() const { return info_; }
+  const SeifOptions& options() const { return options_; }
+
+ private:
+  using Linearized = LinearizedObservation<Z, X, M>;
+  using Init = LandmarkInit<M, X, Z>;
+  using Factor = Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>;
+  /// Information that one observation adds: H^T W H and H^T W nu by blocks, W = Q^-1.
+  struct MeasurementInformation {
+    std::size_t slot;
+    Eigen::Matrix<double, X, X> xx;
+    Eigen::Matrix<double, X, M> xm;
+    Eigen::Matrix<double, M, M> mm;
+    Eigen::Matrix<double, X, 1> r_x;
+    Eigen::Matrix<double, M, 1> r_m;
+  };
+  /// A new landmark as the conditional m = init.m + J_m_x dx + noise with covariance J_m_z Q J_m_z^T.
+  struct NewLandmark {
+    LandmarkId id;
+    Landmark mean;
+    Eigen::Matrix<double, X, X> xx;  ///< J_m_x^T W J_m_x
+    Eigen::Matrix<double, X, M> xm;  ///< -J_m_x^T W
+    Eigen::Matrix<double, M, M> mm;  ///< W
+  };
+
+  static Eigen::Index offset_of(std::size_t slot) { return X + M * static_cast<Eigen::Index>(slot); }
+  Landmark landmark_mean(std::size_t slot) const { return landmark_means_.template segment<M>(M * slot); }
+
+  MeasurementInformation measurement_information(const ObservationType& observation) const;
+  NewLandmark new_landmark(const ObservationType& observation) const;
+  void add(const MeasurementInformation& info);
+  void augment(const NewLandmark& landmark);
+  void recover_mean_locally();
+  void recover_mean_by_coordinate_descent();
+  void recover_mean_of_active_block();
+  Eigen::MatrixXd robot_and_landmarks_block(const std::vector<std::size_t>& slots) const;
+  void update_active_queue(const std::vector<std::size_t>& observed_slots);
+  void sparsify();
+  const Factor& factorization() const;
+  Eigen::MatrixXd marginal_covariance(Eigen::Index offset, Eigen::Index size) const;
+  void touch() { ++revision_; }
+
+  Motion motion_;
+  Sensor sensor_;
+  SeifOptions options_;
+  State x_;
+  Eigen::VectorXd landmark_means_;
+  SparseInformation<X, M> info_;
+  LandmarkPool pool_;
+  std::vector<std::size_t> active_queue_;  ///< slots linked to the robot, most recently observed first
+  std::uint64_t updates_ = 0;
+  std::uint64_t revision_ = 0;
+  mutable std::shared_ptr<const Factor> factor_;  ///< cached factorization of Omega at factor_revision_
+  mutable std::uint64_t factor_revision_ = ~std::uint64_t{0};
+};
+
+}  // namespace sextant
+
+#include "sextant/backends/detail/seif_slam_impl.hpp"

@@ -1,0 +1,21 @@
+#pragma once
+/// \file The inverse measurement model of a new landmark, checked: every back-end adds landmarks
+/// through this one call.
+
+#include <string>
+
+#include "sextant/core/error.hpp"
+#include "sextant/core/observation.hpp"
+
+namespace sextant {
+
+/// sensor.initialize(x, z) for landmark `id`; throws numerical_error when the model returns NaN or Inf.
+template <class Sensor, class State, class Measurement>
+auto initialize_landmark(const Sensor& sensor, const State& x, const Measurement& z, LandmarkId id) {
+  auto init = sensor.initialize(x, z);
+  if (!init.m.allFinite() || !init.J_m_x.allFinite() || !init.J_m_z.allFinite() || !init.Q.allFinite())
+    throw numerical_error("inverse measurement model returned NaN or Inf for landmark " + std::to_string(id));
+  return init;
+}
+
+}  // namespace sextant

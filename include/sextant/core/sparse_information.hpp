@@ -1,0 +1,206 @@
+#pragma once
+/// \file A Gaussian over (robot, landmarks) in error-state information form: the information
+/// matrix Omega, stored by blocks (robot, robot-landmark links, landmark diagonals, landmark-landmark
+/// links), and the residual r = xi - Omega mu of the information vector at the current mean mu.
+/// The mean that the form implies is mu + Omega^-1 r; mean recovery drives r to zero.
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <cstddef>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "sextant/core/error.hpp"
+
+namespace sextant {
+
+template <int X, int M>
+class SparseInformation {
+ public:
+  using RobotBlock = Eigen::Matrix<double, X, X>;
+  using CrossBlock = Eigen::Matrix<double, X, M>;  ///< Omega_{x, m}
+  using LandmarkBlock = Eigen::Matrix<double, M, M>;
+  using RobotVector = Eigen::Matrix<double, X, 1>;
+  using LandmarkVector = Eigen::Matrix<double, M, 1>;
+  using Links = std::unordered_map<std::size_t, LandmarkBlock>;  ///< neighbour slot -> Omega_{i, j}
+
+  explicit SparseInformation(const RobotBlock& robot_information = RobotBlock::Identity())
+      : robot_(robot_information), robot_residual_(RobotVector::Zero()) {}
+
+  std::size_t num_landmarks() const { return diagonal_.size(); }
+  Eigen::Index dim() const { return X + M * static_cast<Eigen::Index>(num_landmarks()); }
+
+  RobotBlock& robot() { return robot_; }
+  const RobotBlock& robot() const { return robot_; }
+  RobotVector& robot_residual() { return robot_residual_; }
+  const RobotVector& robot_residual() const { return robot_residual_; }
+
+  /// The landmarks linked to the robot (SEIF's active landmarks), with Omega_{x, m}.
+  const std::unordered_map<std::size_t, CrossBlock>& robot_links() const { return robot_links_; }
+  bool is_linked_to_robot(std::size_t slot) const { return robot_links_.contains(slot); }
+  void add_to_robot_link(std::size_t slot, const CrossBlock& block) {
+    auto [it, inserted] = robot_links_.try_emplace(slot, block);
+    if (!inserted) it->second += block;
+  }
+  void set_robot_link(std::size_t slot, const CrossBlock& block) { robot_links_[slot] = block; }
+  void remove_robot_link(std::size_t slot) { robot_links_.erase(slot); }
+
+  LandmarkBlock& diagonal(std::size_t slot) { return diagonal_[slot]; }
+  const LandmarkBlock& diagonal(std::size_t slot) const { return diagonal_[slot]; }
+  auto landmark_residual(std::size_t slot) { return landmark_residual_.template segment<M>(M * slot); }
+  auto landmark_residual(std::size_t slot) const { return landmark_residual_.template segment<M>(M * slot); }
+
+  /// Landmark-landmark links of a slot (both directions are stored).
+  const Links& links(std::size_t slot) const { return links_[slot]; }
+  /// Omega_{i, j} += block and Omega_{j, i} += block^T, for i != j.
+  void add_to_link(std::size_t i, std::size_t j, const LandmarkBlock& block) {
+    add_or_insert(links_[i], j, block);
+    add_or_insert(links_[j], i, block.transpose());
+  }
+  /// Omega_{i, j} for any two slots (the diagonal block when i == j, zero when not linked).
+  LandmarkBlock landmark_block(std::size_t i, std::size_t j) const {
+    if (i == j) return diagonal_[i];
+    const auto it = links_[i].find(j);
+    return it == links_[i].end() ? LandmarkBlock::Zero() : it->second;
+  }
+  CrossBlock robot_link(std::size_t slot) const {
+    const auto it = robot_links_.find(slot);
+    return it == robot_links_.end() ? CrossBlock::Zero() : it->second;
+  }
+
+  /// Appends a landmark with no information and no links; returns its slot.
+  std::size_t append_landmark() {
+    diagonal_.push_back(LandmarkBlock::Zero());
+    links_.emplace_back();
+    landmark_residual_.conservativeResize(landmark_residual_.size() + M);
+    landmark_residual_.template tail<M>().setZero();
+    return diagonal_.size() - 1;
+  }
+
+  /// Marginalizes a landmark out (thesis Appendix C): Omega' = Omega_{-j} - Omega_{-j,j} Omega_jj^-1
+  /// Omega_{j,-j}, r' = r_{-j} - Omega_{-j,j} Omega_jj^-1 r_j, touching only its neighbours; then the
+  /// last slot moves into the freed one. Throws numerical_error (form unchanged) if Omega_jj is not PD.
+  void marginalize_landmark(std::size_t slot);
+
+  /// The full symmetric Omega as a sparse matrix, ordered (robot, slot 0, slot 1, ...).
+  Eigen::SparseMatrix<double> to_sparse() const;
+  /// The stacked residual (robot, slot 0, ...).
+  Eigen::VectorXd residual() const {
+    Eigen::VectorXd out(dim());
+    out << robot_residual_, landmark_residual_;
+    return out;
+  }
+  void set_residual(const Eigen::VectorXd& r) {
+    robot_residual_ = r.template head<X>();
+    landmark_residual_ = r.tail(r.size() - X);
+  }
+
+  /// Approximate heap bytes held (blocks and hash-map nodes), for memory reports.
+  std::size_t memory_bytes() const;
+
+ private:
+  template <class Block, class Map>
+  static void add_or_insert(Map& map, std::size_t key, const Block& block) {
+    auto [it, inserted] = map.try_emplace(key, block);
+    if (!inserted) it->second += block;
+  }
+  void move_slot(std::size_t from, std::size_t to);
+
+  RobotBlock robot_;
+  RobotVector robot_residual_;
+  std::unordered_map<std::size_t, CrossBlock> robot_links_;
+  std::vector<LandmarkBlock> diagonal_;
+  std::vector<Links> links_;
+  Eigen::VectorXd landmark_residual_;
+};
+
+template <int X, int M>
+void SparseInformation<X, M>::marginalize_landmark(std::size_t slot) {
+  const Eigen::LLT<LandmarkBlock> llt(diagonal_[slot]);
+  if (llt.info() != Eigen::Success)
+    throw numerical_error("information block of the landmark to marginalize is not positive definite");
+  const LandmarkVector r_j = landmark_residual(slot);
+  const bool robot_linked = is_linked_to_robot(slot);
+  const CrossBlock L_x = robot_link(slot);  // Omega_{x, j}
+  // Omega_{j, a} of every linked landmark a.
+  std::vector<std::pair<std::size_t, LandmarkBlock>> neighbours(links_[slot].begin(), links_[slot].end());
+  // Schur complement on the neighbourhood {robot, linked landmarks}.
+  if (robot_linked) {
+    robot_ -= L_x * llt.solve(L_x.transpose());
+    robot_residual_ -= L_x * llt.solve(r_j);
+  }
+  for (const auto& [a, O_ja] : neighbours) {
+    landmark_residual(a) -= O_ja.transpose() * llt.solve(r_j);
+    diagonal_[a] -= O_ja.transpose() * llt.solve(O_ja);
+    if (robot_linked) add_to_robot_link(a, -L_x * llt.solve(O_ja));
+    for (const auto& [b, O_jb] : neighbours)
+      if (a < b) add_to_link(a, b, -O_ja.transpose() * llt.solve(O_jb));
+  }
+  // Unlink and drop the slot.
+  remove_robot_link(slot);
+  for (const auto& [a, block] : neighbours) links_[a].erase(slot);
+  links_[slot].clear();
+  const std::size_t last = num_landmarks() - 1;
+  if (slot != last) move_slot(last, slot);
+  diagonal_.pop_back();
+  links_.pop_back();
+  landmark_residual_.conservativeResize(landmark_residual_.size() - M);
+}
+
+/// Relabels slot `from` as `to` (which must be empty), fixing every link that points at it.
+template <int X, int M>
+void SparseInformation<X, M>::move_slot(std::size_t from, std::size_t to) {
+  diagonal_[to] = diagonal_[from];
+  landmark_residual(to) = landmark_residual(from);
+  links_[to] = std::move(links_[from]);
+  links_[from].clear();
+  for (auto& [neighbour, block] : links_[to]) {
+    auto& back = links_[neighbour];
+    auto node = back.extract(from);
+    node.key() = to;
+    back.insert(std::move(node));
+  }
+  if (auto node = robot_links_.extract(from); !node.empty()) {
+    node.key() = to;
+    robot_links_.insert(std::move(node));
+  }
+}
+
+template <int X, int M>
+Eigen::SparseMatrix<double> SparseInformation<X, M>::to_sparse() const {
+  std::vector<Eigen::Triplet<double>> triplets;
+  auto add_block = [&](Eigen::Index row, Eigen::Index col, const auto& block) {
+    for (Eigen::Index c = 0; c < block.cols(); ++c)
+      for (Eigen::Index r = 0; r < block.rows(); ++r) triplets.emplace_back(row + r, col + c, block(r, c));
+  };
+  auto offset = [](std::size_t slot) { return X + M * static_cast<Eigen::Index>(slot); };
+  add_block(0, 0, robot_);
+  for (const auto& [slot, block] : robot_links_) {
+    add_block(0, offset(slot), block);
+    add_block(offset(slot), 0, block.transpose());
+  }
+  for (std::size_t i = 0; i < num_landmarks(); ++i) {
+    add_block(offset(i), offset(i), diagonal_[i]);
+    for (const auto& [j, block] : links_[i]) add_block(offset(i), offset(j), block);
+  }
+  Eigen::SparseMatrix<double> out(dim(), dim());
+  out.setFromTriplets(triplets.begin(), triplets.end());
+  return out;
+}
+
+template <int X, int M>
+std::size_t SparseInformation<X, M>::memory_bytes() const {
+  constexpr std::size_t node_overhead = 2 * sizeof(void*) + sizeof(std::size_t);  // hash node: next, key, hash
+  std::size_t bytes = sizeof(*this) + diagonal_.capacity() * sizeof(LandmarkBlock) +
+                      static_cast<std::size_t>(landmark_residual_.size()) * sizeof(double) +
+                      links_.capacity() * sizeof(Links) +
+                      robot_links_.size() * (sizeof(CrossBlock) + node_overhead) +
+                      robot_links_.bucket_count() * sizeof(void*);
+  for (const auto& links : links_)
+    bytes += links.size() * (sizeof(LandmarkBlock) + node_overhead) + links.bucket_count() * sizeof(void*);
+  return bytes;
+}
+
+}  // namespace sextant

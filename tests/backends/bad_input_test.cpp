@@ -1,0 +1,152 @@
+// Bad input gives a sextant::error naming the problem, and the back-end's state stays exactly as it
+// was: one typed test for every back-end and update mode.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "sextant/backends/ekf_slam.hpp"
+#include "sextant/backends/seif_slam.hpp"
+#include "sextant/eval/runner.hpp"
+#include "sextant/models/beacon_ship_2d.hpp"
+#include "support/batch_least_squares.hpp"
+
+namespace sextant {
+namespace {
+
+using Obs = Observation<Eigen::Vector2d>;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+const Gaussian<Eigen::Vector2d, 2> kPrior{Eigen::Vector2d::Zero(), Eigen::Matrix2d::Identity()};
+
+/// Back-end configurations under test: make(motion, sensor, prior) builds one.
+struct EkfBatch {
+  template <class Motion, class Sensor>
+  static auto make(Motion motion, Sensor sensor, const Gaussian<Eigen::Vector2d, 2>& prior) {
+    return EkfSlam<Motion, Sensor>{motion, sensor, prior, {.batch_update = true}};
+  }
+};
+struct EkfSequential {
+  template <class Motion, class Sensor>
+  static auto make(Motion motion, Sensor sensor, const Gaussian<Eigen::Vector2d, 2>& prior) {
+    return EkfSlam<Motion, Sensor>{motion, sensor, prior, {.batch_update = false}};
+  }
+};
+struct SeifSparsified {
+  template <class Motion, class Sensor>
+  static auto make(Motion motion, Sensor sensor, const Gaussian<Eigen::Vector2d, 2>& prior) {
+    return SeifSlam<Motion, Sensor>{motion, sensor, prior, {.max_active = 3}};
+  }
+};
+struct SeifExactRecovery {
+  template <class Motion, class Sensor>
+  static auto make(Motion motion, Sensor sensor, const Gaussian<Eigen::Vector2d, 2>& prior) {
+    return SeifSlam<Motion, Sensor>{motion, sensor, prior, {.exact_recovery_period = 1}};
+  }
+};
+
+template <class Backend>
+struct Snapshot {
+  explicit Snapshot(const Backend& backend) : pose(backend.pose()), map(backend.map()) {}
+  void expect_same_as(const Backend& backend) const {
+    const auto now = backend.pose();
+    EXPECT_EQ(pose.mean, now.mean);
+    EXPECT_EQ(pose.cov, now.cov);
+    const auto map_now = backend.map();
+    ASSERT_EQ(map.size(), map_now.size());
+    for (std::size_t i = 0; i < map.size(); ++i) {
+      EXPECT_EQ(map[i].id, map_now[i].id);
+      EXPECT_EQ(map[i].mean, map_now[i].mean);
+      EXPECT_EQ(map[i].cov, map_now[i].cov);
+    }
+  }
+  typename Backend::PoseEstimate pose;
+  typename Backend::MapEstimate map;
+};
+
+template <class Config>
+class BadInput : public ::testing::Test {
+ protected:
+  using Backend = decltype(Config::make(BeaconShip2D{}, BeaconOffset2D{}, kPrior));
+  BadInput() : backend_(Config::make(BeaconShip2D{}, BeaconOffset2D{}, kPrior)) {
+    eval::run(backend_, test::random_linear_steps(12, 5, 3));
+  }
+  template <class Call>
+  void expect_error_and_no_change(Call call, const std::string& fragment) {
+    const Snapshot<Backend> before(backend_);
+    try {
+      call();
+      ADD_FAILURE() << "expected a sextant::error mentioning '" << fragment << "'";
+    } catch (const error& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+    before.expect_same_as(backend_);
+  }
+  LandmarkId known(std::size_t i) const { return backend_.landmark_ids().at(i); }
+  Backend backend_;
+};
+
+using Configs = ::testing::Types<EkfBatch, EkfSequential, SeifSparsified, SeifExactRecovery>;
+TYPED_TEST_SUITE(BadInput, Configs);
+
+TYPED_TEST(BadInput, NaNOrInfControl) {
+  this->expect_error_and_no_change([&] { this->backend_.predict(Eigen::Vector2d(kNaN, 0.0), 1.0); }, "control");
+  this->expect_error_and_no_change([&] { this->backend_.predict(Eigen::Vector2d(1.0, kInf), 1.0); }, "control");
+}
+
+TYPED_TEST(BadInput, NonPositiveOrNonFiniteTimeStep) {
+  for (double dt : {0.0, -1.0, kNaN, kInf})
+    this->expect_error_and_no_change([&] { this->backend_.predict(Eigen::Vector2d(1.0, 0.0), dt); }, "dt");
+}
+
+TYPED_TEST(BadInput, NaNMeasurementAfterValidOnesInTheSameUpdate) {
+  const std::vector<Obs> observations{{this->known(0), {1.0, 1.0}}, {this->known(1), {2.0, 1.0}}, {999, {1.0, 1.0}},
+                                      {this->known(2), {kNaN, 0.0}}};
+  this->expect_error_and_no_change([&] { this->backend_.update(observations); },
+                                   "measurement of landmark " + std::to_string(this->known(2)));
+}
+
+TYPED_TEST(BadInput, LandmarkRepeatedWithinOneUpdate) {
+  const std::vector<Obs> repeated_known{{this->known(0), {1.0, 1.0}}, {this->known(1), {2.0, 1.0}},
+                                        {this->known(0), {1.1, 1.0}}};
+  this->expect_error_and_no_change([&] { this->backend_.update(repeated_known); }, "twice");
+  const std::vector<Obs> repeated_new{{500, {1.0, 1.0}}, {500, {1.0, 1.1}}};
+  this->expect_error_and_no_change([&] { this->backend_.update(repeated_new); }, "twice");
+}
+
+TYPED_TEST(BadInput, RemoveUnknownLandmark) {
+  this->expect_error_and_no_change([&] { this->backend_.remove_landmark(12345); }, "unknown landmark id 12345");
+  EXPECT_THROW(this->backend_.remove_landmark(12345), unknown_landmark_error);
+}
+
+/// A sensor whose noise is indefinite for far landmarks: no consistent update is possible.
+struct BrokenNoiseSensor : BeaconOffset2D {
+  MeasurementPrediction<2, 2, 2> predict(const Eigen::Vector2d& x, const Landmark& m) const {
+    auto out = BeaconOffset2D::predict(x, m);
+    if (m.x() > 1e5) out.Q = -1e9 * Eigen::Matrix2d::Identity();
+    return out;
+  }
+};
+
+TYPED_TEST(BadInput, NoiseOrInnovationNotPositiveDefinite) {
+  auto backend = TypeParam::make(BeaconShip2D{}, BrokenNoiseSensor{}, kPrior);
+  backend.update(std::vector<Obs>{{1, {1.0, 0.0}}, {2, {2e5, 0.0}}});
+  const Snapshot<decltype(backend)> before(backend);
+  try {
+    backend.update(std::vector<Obs>{{1, {1.1, 0.0}}, {2, {2e5, 0.0}}, {3, {0.0, 1.0}}});
+    ADD_FAILURE() << "expected numerical_error";
+  } catch (const numerical_error& e) {
+    EXPECT_NE(std::string(e.what()).find("not positive definite"), std::string::npos) << e.what();
+  }
+  before.expect_same_as(backend);
+  EXPECT_FALSE(backend.has_landmark(3));
+}
+
+TYPED_TEST(BadInput, NonFiniteOrIndefinitePriorIsRejected) {
+  EXPECT_THROW(TypeParam::make(BeaconShip2D{}, BeaconOffset2D{}, {Eigen::Vector2d(kNaN, 0.0), Eigen::Matrix2d::Identity()}),
+               invalid_input_error);
+  EXPECT_THROW(TypeParam::make(BeaconShip2D{}, BeaconOffset2D{}, {Eigen::Vector2d::Zero(), -Eigen::Matrix2d::Identity()}),
+               numerical_error);
+}
+
+}  // namespace
+}  // namespace sextant

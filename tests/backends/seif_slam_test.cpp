@@ -1,0 +1,124 @@
+#include "sextant/backends/seif_slam.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/SparseCholesky>
+
+#include "sextant/backends/ekf_slam.hpp"
+#include "sextant/eval/runner.hpp"
+#include "sextant/models/beacon_ship_2d.hpp"
+#include "sextant/sim/ship_2d.hpp"
+#include "support/batch_least_squares.hpp"
+
+namespace sextant {
+namespace {
+
+using Seif = SeifSlam<BeaconShip2D, BeaconOffset2D>;
+using Ekf = EkfSlam<BeaconShip2D, BeaconOffset2D>;
+static_assert(SlamBackend<Seif>);
+
+double max_relative_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).cwiseAbs().maxCoeff() / std::max(1e-300, b.cwiseAbs().maxCoeff());
+}
+
+TEST(SeifSlam, WithoutSparsificationEqualsEkfOverTheWholeShipRun) {
+  const auto data = sim::simulate_ship_2d({.seed = 5});
+  Ekf ekf{data.motion, data.sensor, data.prior};
+  Seif seif{data.motion, data.sensor, data.prior, {.max_active = 0, .exact_recovery_period = 1}};
+  double worst_mean = 0.0, worst_cov = 0.0;
+  for (std::size_t k = 0; k < data.steps.size(); ++k) {
+    const auto& step = data.steps[k];
+    ekf.predict(step.control, step.dt);
+    seif.predict(step.control, step.dt);
+    ekf.update(step.observations);
+    seif.update(step.observations);
+    const auto e = ekf.pose(), s = seif.pose();
+    worst_mean = std::max(worst_mean, (e.mean - s.mean).cwiseAbs().maxCoeff());
+    worst_cov = std::max(worst_cov, max_relative_difference(s.cov, e.cov));
+    if (k % 100 == 0 || k + 1 == data.steps.size()) {
+      for (const auto& landmark : ekf.map()) {
+        const auto other = seif.landmark(landmark.id);
+        worst_mean = std::max(worst_mean, (landmark.mean - other.mean).cwiseAbs().maxCoeff());
+        worst_cov = std::max(worst_cov, max_relative_difference(other.cov, landmark.cov));
+      }
+    }
+  }
+  EXPECT_LT(worst_mean, 1e-6);
+  EXPECT_LT(worst_cov, 1e-6);
+  RecordProperty("worst_mean_difference", std::to_string(worst_mean));
+  RecordProperty("worst_relative_covariance_difference", std::to_string(worst_cov));
+}
+
+TEST(SeifSlam, LinearGaussianProblemEqualsExactBatchLeastSquares) {
+  const BeaconShip2D motion{0.3, 0.2, HeadingNoise::linearized};
+  const BeaconOffset2D sensor{0.5};
+  const Gaussian<Eigen::Vector2d, 2> prior{Eigen::Vector2d(1.0, -2.0), 0.04 * Eigen::Matrix2d::Identity()};
+  const auto steps = test::random_linear_steps(60, 6, 7);
+  const auto batch = test::solve_linear_ship_problem(motion, sensor, prior, steps);
+  Seif seif{motion, sensor, prior, {.max_active = 0, .mean_recovery_sweeps = 1}};
+  eval::run(seif, steps);
+  seif.recover_mean_exactly();
+  const Eigen::Index p = batch.final_pose_offset;
+  EXPECT_LT((seif.pose().mean - batch.mean.segment<2>(p)).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((seif.pose().cov - batch.covariance.block<2, 2>(p, p)).cwiseAbs().maxCoeff(), 1e-9);
+  for (const auto& [id, offset] : batch.landmark_offset) {
+    const auto landmark = seif.landmark(id);
+    EXPECT_LT((landmark.mean - batch.mean.segment<2>(offset)).cwiseAbs().maxCoeff(), 1e-9) << id;
+    EXPECT_LT((landmark.cov - batch.covariance.block<2, 2>(offset, offset)).cwiseAbs().maxCoeff(), 1e-9) << id;
+  }
+}
+
+TEST(SeifSlam, InformationMatrixStaysPositiveDefiniteAndSparseAtEveryStep) {
+  const auto data = sim::simulate_ship_2d({.seed = 6});
+  for (std::size_t max_active : {4u, 8u}) {
+    Seif seif{data.motion, data.sensor, data.prior, {.max_active = max_active}};
+    for (std::size_t k = 0; k < data.steps.size(); ++k) {
+      seif.predict(data.steps[k].control, data.steps[k].dt);
+      seif.update(data.steps[k].observations);
+      ASSERT_LE(seif.active_landmarks().size(), max_active) << "step " << k;
+      ASSERT_EQ(seif.information().robot_links().size(), seif.active_landmarks().size()) << "step " << k;
+      const Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt(seif.information_matrix());
+      ASSERT_EQ(llt.info(), Eigen::Success) << "sparse Cholesky of Omega failed at step " << k;
+    }
+    // Sparse: far fewer non-zeros than a dense matrix of the same size.
+    const auto omega = seif.information_matrix();
+    EXPECT_LT(static_cast<double>(omega.nonZeros()), 0.25 * static_cast<double>(omega.rows() * omega.cols()));
+  }
+}
+
+TEST(SeifSlam, SparsifiedFilterStaysCloseToTheTruth) {
+  const auto data = sim::simulate_ship_2d({.seed = 8});
+  Seif seif{data.motion, data.sensor, data.prior, {.max_active = 5}};
+  const auto record = eval::run(seif, data.steps);
+  EXPECT_LT((record.steps.back().pose.mean - data.true_poses.back()).norm(), 15.0);
+  for (const auto& landmark : seif.map()) EXPECT_LT((landmark.mean - data.true_landmarks.at(landmark.id)).norm(), 80.0);
+}
+
+TEST(SeifSlam, RemoveLandmarkMarginalizesWithoutChangingTheOtherMarginals) {
+  const auto data = sim::simulate_ship_2d({.seed = 9, .num_steps = 120});
+  Seif seif{data.motion, data.sensor, data.prior, {.max_active = 4, .exact_recovery_period = 1}};
+  eval::run(seif, data.steps);
+  const auto before = seif.map();
+  const auto pose_before = seif.pose();
+  const LandmarkId removed = before[before.size() / 2].id;
+  seif.remove_landmark(removed);
+  EXPECT_FALSE(seif.has_landmark(removed));
+  EXPECT_EQ(seif.num_landmarks(), before.size() - 1);
+  EXPECT_LT((seif.pose().cov - pose_before.cov).cwiseAbs().maxCoeff(), 1e-9);
+  for (const auto& estimate : before) {
+    if (estimate.id == removed) continue;
+    const auto after = seif.landmark(estimate.id);
+    EXPECT_EQ(after.mean, estimate.mean);
+    EXPECT_LT((after.cov - estimate.cov).cwiseAbs().maxCoeff(), 1e-9) << estimate.id;
+  }
+  EXPECT_THROW(seif.remove_landmark(removed), unknown_landmark_error);
+}
+
+TEST(SeifSlam, RejectsNegativeOptions) {
+  EXPECT_THROW((Seif{BeaconShip2D{}, BeaconOffset2D{}, {Eigen::Vector2d::Zero(), Eigen::Matrix2d::Identity()},
+                     {.mean_recovery_sweeps = -1}}),
+               invalid_input_error);
+}
+
+}  // namespace
+}  // namespace sextant
