@@ -43,7 +43,11 @@ const BeaconShip2D kMotion{0.05, 0.01, HeadingNoise::linearized};
 const BeaconOffset2D kSensor{0.1};
 Gaussian<Eigen::Vector2d, 2> prior(const CircleWorld& world) { return {world.ship(0), 0.01 * Eigen::Matrix2d::Identity()}; }
 
-std::size_t heap_in_use() { return mallinfo2().uordblks; }
+/// Heap bytes in use: small blocks plus the mmapped large ones (a big covariance lives there).
+std::size_t heap_in_use() {
+  const auto info = mallinfo2();
+  return info.uordblks + info.hblkhd;
+}
 
 /// SEIF after one lap: every beacon mapped, the way a filter builds its map.
 Seif seif_after_one_lap(const CircleWorld& world) {

@@ -46,6 +46,10 @@ TEST(GrowableSquareMatrix, GrowKeepsContentAndZeroesTheNewBlock) {
   EXPECT_EQ(m.view()(1, 0), 3.0);
   EXPECT_EQ(m.view().bottomRightCorner(60, 60).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_EQ(m.view().topRightCorner(2, 60).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LE(m.capacity(), 93);  // grows by half: never more than 1.5x the dimension
+  m.reserve(200);
+  EXPECT_EQ(m.capacity(), 200);
+  EXPECT_EQ(m.view()(1, 0), 3.0);
 }
 
 TEST(GrowableSquareMatrix, RemovingABlockEqualsDeletingItsRowsAndColumnsAfterAPermutation) {

@@ -69,6 +69,9 @@ class EkfSlam {
   UpdateResult update(std::span<const ObservationType> observations);
   UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }
 
+  /// Reserves memory for a map of `landmarks` landmarks (the covariance is (X + M n)^2 doubles).
+  void reserve(std::size_t landmarks) { cov_.reserve(X + M * static_cast<Eigen::Index>(landmarks)); }
+
   /// Marginalizes a landmark out of the joint Gaussian. Throws unknown_landmark_error.
   void remove_landmark(LandmarkId id);
 

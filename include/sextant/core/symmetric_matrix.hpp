@@ -64,15 +64,20 @@ class GrowableSquareMatrix {
   auto view() { return storage_.topLeftCorner(dim_, dim_); }
   auto view() const { return storage_.topLeftCorner(dim_, dim_); }
 
-  /// Appends `count` zero rows and columns.
+  /// Makes room for a dimension of at least `dim` without reallocating later.
+  void reserve(Index dim) {
+    if (dim <= storage_.rows()) return;
+    Eigen::MatrixXd bigger(dim, dim);
+    bigger.topLeftCorner(dim_, dim_) = view();
+    storage_.swap(bigger);
+  }
+  Index capacity() const { return storage_.rows(); }
+
+  /// Appends `count` zero rows and columns; the buffer grows by half when full (at most 2.25x the
+  /// memory of the matrix, amortized O(dim) per added row).
   void grow(Index count) {
     const Index needed = dim_ + count;
-    if (needed > storage_.rows()) {
-      const Index capacity = std::max(needed, 2 * storage_.rows());
-      Eigen::MatrixXd bigger(capacity, capacity);
-      bigger.topLeftCorner(dim_, dim_) = view();
-      storage_.swap(bigger);
-    }
+    if (needed > storage_.rows()) reserve(std::max(needed, storage_.rows() + storage_.rows() / 2));
     storage_.block(0, dim_, needed, count).setZero();
     storage_.block(dim_, 0, count, needed).setZero();
     dim_ = needed;

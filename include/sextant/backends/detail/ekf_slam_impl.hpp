@@ -170,6 +170,8 @@ auto EkfSlam<Motion, Sensor>::plan(std::span<const ObservationType> known, std::
 template <class Motion, class Sensor>
 void EkfSlam<Motion, Sensor>::commit(const Plan& plan) {
   if (plan.correction) apply(*plan.correction);
+  if (plan.new_landmarks.size() > 1)  // one allocation for a batch of new landmarks
+    cov_.reserve(cov_.dim() + M * static_cast<Eigen::Index>(plan.new_landmarks.size()));
   for (const auto& [id, init] : plan.new_landmarks) augment(id, init);
 }
 
