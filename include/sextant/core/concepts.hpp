@@ -30,6 +30,13 @@ concept MotionModel =
       { u.allFinite() } -> std::convertible_to<bool>;
     };
 
+/// A motion model that also offers the full-SLAM factor between two poses (see BetweenFactor).
+template <class M>
+concept HasBetweenFactor =
+    MotionModel<M> && requires(const M& model, const typename M::State& x, const typename M::Control& u, double dt) {
+      { model.between(x, x, u, dt) } -> std::same_as<BetweenFactor<M::kDim>>;
+    };
+
 /// Tangent dimension of a measurement model's Landmark and Measurement types.
 template <class S>
 inline constexpr int landmark_dim_v = S::Landmark::RowsAtCompileTime;

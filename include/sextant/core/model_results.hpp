@@ -34,4 +34,16 @@ struct LandmarkInit {
   Eigen::Matrix<double, Z, Z> Q;
 };
 
+/// Optional, for full SLAM: the motion factor between two poses as a residual whose covariance does
+/// not depend on the poses (e.g. odometry in the robot frame), with its Jacobians. A model whose
+/// process noise R depends on the state should offer it: Gauss-Newton on minus(x', g(x, u)) with
+/// W = R(x)^-1 would treat W as constant and converge only linearly.
+template <int X>
+struct BetweenFactor {
+  Eigen::Matrix<double, X, 1> r;       ///< zero when x_to = g(x_from, u) exactly
+  Eigen::Matrix<double, X, X> J_from;  ///< dr / dx_from (tangent space)
+  Eigen::Matrix<double, X, X> J_to;    ///< dr / dx_to
+  Eigen::Matrix<double, X, X> cov;     ///< covariance of r
+};
+
 }  // namespace sextant

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <concepts>
 #include <span>
 #include <string>
 #include <unordered_set>
@@ -13,9 +14,11 @@
 
 namespace sextant {
 
-/// Throws invalid_input_error naming `what` when a vector or matrix has NaN or Inf entries.
-template <class Derived>
-void require_finite(const Eigen::DenseBase<Derived>& value, const std::string& what) {
+/// Throws invalid_input_error naming `what` when a value (an Eigen vector or matrix, or any type
+/// with allFinite(), such as a control carrying its own covariance) has NaN or Inf entries.
+template <class T>
+  requires requires(const T& t) { { t.allFinite() } -> std::convertible_to<bool>; }
+void require_finite(const T& value, const std::string& what) {
   if (!value.allFinite()) throw invalid_input_error(what + " contains NaN or Inf");
 }
 

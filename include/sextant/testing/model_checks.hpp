@@ -74,6 +74,31 @@ CheckResult check_motion_jacobians(const Motion& model, const typename Motion::S
   return result;
 }
 
+/// Checks J_from and J_to of a motion model's between(from, to, u, dt) factor, and that the factor
+/// vanishes at to = predict(from, u, dt).
+template <class Motion>
+  requires HasBetweenFactor<Motion>
+CheckResult check_between_jacobians(const Motion& model, const typename Motion::State& from,
+                                    const typename Motion::State& to, const typename Motion::Control& u, double dt,
+                                    CheckOptions options = {}) {
+  using Space = typename Motion::Space;
+  const auto shift = [](const auto& s, const auto& d) { return Space::plus(s, d); };
+  const auto difference = [](const auto& a, const auto& b) { return (a - b).eval(); };
+  CheckResult result;
+  const auto factor = model.between(from, to, u, dt);
+  detail::compare("J_from", factor.J_from,
+                  detail::central_difference<Motion::kDim>(
+                      from, shift, [&](const auto& x) { return model.between(x, to, u, dt).r; }, difference, options.step),
+                  options, result);
+  detail::compare("J_to", factor.J_to,
+                  detail::central_difference<Motion::kDim>(
+                      to, shift, [&](const auto& x) { return model.between(from, x, u, dt).r; }, difference, options.step),
+                  options, result);
+  detail::compare("between(from, predict(from, u)).r", model.between(from, model.predict(from, u, dt).x, u, dt).r,
+                  Eigen::Matrix<double, Motion::kDim, 1>::Zero(), options, result);
+  return result;
+}
+
 /// Checks J_z_x and J_z_m of predict(x, m), and J_m_x and J_m_z of initialize(x, z), and that
 /// predict(x, initialize(x, z).m) reproduces z.
 /// Call as check_measurement_jacobians<MyMotion>(sensor, x, m).

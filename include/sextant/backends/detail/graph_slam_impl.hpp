@@ -1,0 +1,452 @@
+#pragma once
+// Bodies of GraphSlam (see ../graph_slam.hpp).
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <string>
+#include <utility>
+
+#include "sextant/core/landmark_init.hpp"
+#include "sextant/core/sparse_cholesky.hpp"
+#include "sextant/core/validation.hpp"
+
+namespace sextant {
+
+/// The Gauss-Newton system at the current estimate, by blocks: Omega delta = b, b = -gradient
+/// (thesis eqs. 58-64, Appendix B), over poses 0 .. pose_count - 1 and the landmarks they saw.
+template <class Motion, class Sensor>
+struct GraphSlam<Motion, Sensor>::Linearization {
+  struct PoseLink {
+    std::size_t a, b;  ///< a < b
+    Eigen::Matrix<double, X, X> block;  ///< Omega_ab
+  };
+  struct LandmarkTerms {
+    std::size_t slot;
+    Eigen::Matrix<double, M, M> diagonal = Eigen::Matrix<double, M, M>::Zero();
+    Eigen::Matrix<double, M, 1> rhs = Eigen::Matrix<double, M, 1>::Zero();
+    std::vector<std::pair<std::size_t, Eigen::Matrix<double, X, M>>> poses;  ///< Omega_pj per observing pose
+  };
+  std::size_t pose_count = 0;
+  std::vector<Eigen::Matrix<double, X, X>> pose_diagonal;
+  std::vector<PoseLink> pose_links;
+  Eigen::VectorXd pose_rhs;
+  std::vector<LandmarkTerms> landmarks;
+  double cost = 0.0;
+
+  Eigen::Index dim() const { return X * static_cast<Eigen::Index>(pose_count) + M * static_cast<Eigen::Index>(landmarks.size()); }
+
+  /// The whole information matrix (poses, then landmarks in this system's order), whole blocks stored.
+  Eigen::SparseMatrix<double> assemble() const {
+    std::vector<Eigen::Triplet<double>> triplets;
+    auto add = [&](Eigen::Index row, Eigen::Index col, const auto& block) {
+      for (Eigen::Index c = 0; c < block.cols(); ++c)
+        for (Eigen::Index r = 0; r < block.rows(); ++r) triplets.emplace_back(row + r, col + c, block(r, c));
+    };
+    for (std::size_t p = 0; p < pose_count; ++p) add(X * p, X * p, pose_diagonal[p]);
+    for (const auto& link : pose_links) {
+      add(X * link.a, X * link.b, link.block);
+      add(X * link.b, X * link.a, link.block.transpose());
+    }
+    const Eigen::Index base = X * static_cast<Eigen::Index>(pose_count);
+    for (std::size_t j = 0; j < landmarks.size(); ++j) {
+      const Eigen::Index row = base + M * static_cast<Eigen::Index>(j);
+      add(row, row, landmarks[j].diagonal);
+      for (const auto& [p, block] : landmarks[j].poses) {
+        add(X * p, row, block);
+        add(row, X * p, block.transpose());
+      }
+    }
+    Eigen::SparseMatrix<double> out(dim(), dim());
+    out.setFromTriplets(triplets.begin(), triplets.end());
+    return out;
+  }
+};
+
+template <class Motion, class Sensor>
+GraphSlam<Motion, Sensor>::GraphSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, GraphOptions options)
+    : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), prior_(prior) {
+  if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
+  prior_information_ = symmetrized(
+      cholesky_or_throw(prior.cov, "prior covariance").solve(Eigen::Matrix<double, X, X>::Identity()));
+  if (options_.max_iterations < 1 || options_.window_iterations < 1)
+    throw invalid_input_error("GraphOptions: max_iterations and window_iterations must be >= 1");
+  poses_.push_back(prior.mean);
+}
+
+template <class Motion, class Sensor>
+void GraphSlam<Motion, Sensor>::predict(const Control& u, double dt) {
+  require_finite(u, "control");
+  require_positive_time_step(dt);
+  const auto prediction = motion_.predict(poses_.back(), u, dt);
+  if (!Space::is_finite(prediction.x) || !prediction.J_x_x.allFinite() || !prediction.R.allFinite())
+    throw numerical_error("motion model returned NaN or Inf");
+  cholesky_or_throw(prediction.R, "process noise R of step " + std::to_string(motions_.size()));
+  motions_.push_back({u, dt});
+  poses_.push_back(prediction.x);
+  touch();
+}
+
+template <class Motion, class Sensor>
+UpdateResult GraphSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
+  require_valid_observations(observations);
+  const auto [known, fresh] = split_known_and_new(pool_, observations);
+  const std::size_t pose = poses_.size() - 1;
+  std::vector<LandmarkInit<M, X, Z>> inits;
+  for (const auto& observation : fresh)
+    inits.push_back(initialize_landmark(sensor_, poses_[pose], observation.z, observation.landmark_id));
+  for (const auto& observation : known) measurements_[pool_.slot(observation.landmark_id)].push_back({pose, observation.z});
+  for (std::size_t i = 0; i < fresh.size(); ++i) {
+    pool_.add(fresh[i].landmark_id);
+    measurements_.push_back({{pose, fresh[i].z}});
+    landmark_means_.conservativeResize(landmark_means_.size() + M);
+    landmark_means_.template tail<M>() = inits[i].m;
+  }
+  touch();
+  return {known.size(), fresh.size(), {}};
+}
+
+/// The motion factor between poses k and k + 1: the model's own between() when it has one, else
+/// r = minus(x_k+1, g(x_k, u)) with J_from = -G, J_to = I and covariance R (thesis eqs. 60-61).
+template <class Motion, class Sensor>
+BetweenFactor<GraphSlam<Motion, Sensor>::X> GraphSlam<Motion, Sensor>::motion_factor(std::size_t k) const {
+  if constexpr (HasBetweenFactor<Motion>) {
+    return motion_.between(poses_[k], poses_[k + 1], motions_[k].u, motions_[k].dt);
+  } else {
+    const auto prediction = motion_.predict(poses_[k], motions_[k].u, motions_[k].dt);
+    return {Space::minus(poses_[k + 1], prediction.x), -prediction.J_x_x, Eigen::Matrix<double, X, X>::Identity(),
+            prediction.R};
+  }
+}
+
+/// Residuals r = f(x) - target with Jacobians J, weights W: Omega += J^T W J, b -= J^T W r, cost += r^T W r.
+/// Prior r = minus(x_0, mu_0) (eq. 64); motion r = minus(x_k+1, g(x_k, u)), J = [-G, I] (eqs. 60-61);
+/// measurement r = -residual(z, h(x, m)), J = [J_z_x, J_z_m] (eqs. 62-63).
+template <class Motion, class Sensor>
+auto GraphSlam<Motion, Sensor>::linearize(std::size_t pose_count) const -> Linearization {
+  using MatrixX = Eigen::Matrix<double, X, X>;
+  Linearization sys;
+  sys.pose_count = pose_count;
+  sys.pose_diagonal.assign(pose_count, MatrixX::Zero());
+  sys.pose_rhs = Eigen::VectorXd::Zero(X * static_cast<Eigen::Index>(pose_count));
+  auto rhs = [&](std::size_t p) { return sys.pose_rhs.template segment<X>(X * p); };
+
+  const Eigen::Matrix<double, X, 1> r0 = Space::minus(poses_[0], prior_.mean);
+  sys.pose_diagonal[0] += prior_information_;
+  rhs(0) -= prior_information_ * r0;
+  sys.cost += r0.dot(prior_information_ * r0);
+
+  for (std::size_t k = 0; k + 1 < pose_count; ++k) {
+    const BetweenFactor<X> factor = motion_factor(k);
+    const auto llt = cholesky_or_throw(factor.cov, "process noise of step " + std::to_string(k));
+    const MatrixX W_from = llt.solve(factor.J_from), W_to = llt.solve(factor.J_to);
+    const Eigen::Matrix<double, X, 1> W_r = llt.solve(factor.r);
+    sys.pose_diagonal[k] += factor.J_from.transpose() * W_from;
+    sys.pose_diagonal[k + 1] += factor.J_to.transpose() * W_to;
+    sys.pose_links.push_back({k, k + 1, factor.J_from.transpose() * W_to});
+    rhs(k) -= factor.J_from.transpose() * W_r;
+    rhs(k + 1) -= factor.J_to.transpose() * W_r;
+    sys.cost += factor.r.dot(W_r);
+  }
+
+  for (const auto& factor : linear_factors_) {
+    if (*std::max_element(factor.poses.begin(), factor.poses.end()) >= pose_count) continue;
+    Eigen::VectorXd d(X * static_cast<Eigen::Index>(factor.poses.size()));
+    for (std::size_t i = 0; i < factor.poses.size(); ++i)
+      d.template segment<X>(X * i) = Space::minus(poses_[factor.poses[i]], factor.linearization[i]);
+    const Eigen::VectorXd b = factor.eta - factor.Lambda * d;
+    for (std::size_t i = 0; i < factor.poses.size(); ++i) {
+      rhs(factor.poses[i]) += b.template segment<X>(X * i);
+      for (std::size_t k = 0; k < factor.poses.size(); ++k) {
+        const MatrixX block = factor.Lambda.template block<X, X>(X * i, X * k);
+        if (factor.poses[i] == factor.poses[k])
+          sys.pose_diagonal[factor.poses[i]] += block;
+        else if (factor.poses[i] < factor.poses[k])
+          sys.pose_links.push_back({factor.poses[i], factor.poses[k], block});
+      }
+    }
+    sys.cost += d.dot(factor.Lambda * d) - 2.0 * factor.eta.dot(d);
+  }
+
+  for (std::size_t slot = 0; slot < measurements_.size(); ++slot) {
+    typename Linearization::LandmarkTerms terms;
+    terms.slot = slot;
+    for (const auto& record : measurements_[slot]) {
+      if (record.pose >= pose_count) continue;
+      const auto prediction = sensor_.predict(poses_[record.pose], landmark_mean(slot));
+      const Eigen::Matrix<double, Z, 1> r = -sensor_.residual(record.z, prediction.z);
+      const auto llt = cholesky_or_throw(prediction.Q, "measurement noise Q of landmark " + std::to_string(pool_.id_at(slot)));
+      const Eigen::Matrix<double, Z, X> W_Jx = llt.solve(prediction.J_z_x);
+      const Eigen::Matrix<double, Z, M> W_Jm = llt.solve(prediction.J_z_m);
+      const Eigen::Matrix<double, Z, 1> W_r = llt.solve(r);
+      sys.pose_diagonal[record.pose] += prediction.J_z_x.transpose() * W_Jx;
+      rhs(record.pose) -= prediction.J_z_x.transpose() * W_r;
+      terms.diagonal += prediction.J_z_m.transpose() * W_Jm;
+      terms.rhs -= prediction.J_z_m.transpose() * W_r;
+      terms.poses.emplace_back(record.pose, prediction.J_z_x.transpose() * W_Jm);
+      sys.cost += r.dot(W_r);
+    }
+    if (!terms.poses.empty()) sys.landmarks.push_back(std::move(terms));
+  }
+  if (!std::isfinite(sys.cost) || !sys.pose_rhs.allFinite()) throw numerical_error("GraphSLAM linearization is not finite");
+  return sys;
+}
+
+/// Thesis eqs. (66)-(69), (72)-(73): S = Omega_pp - sum_j Omega_pj Omega_jj^-1 Omega_jp,
+/// b_S = b_p - sum_j Omega_pj Omega_jj^-1 b_j; S delta_p = b_S; delta_j = Omega_jj^-1 (b_j - Omega_jp delta_p).
+template <class Motion, class Sensor>
+Eigen::VectorXd GraphSlam<Motion, Sensor>::solve_by_landmark_schur(const Linearization& sys,
+                                                                    OptimizationSummary& summary) const {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  std::vector<Eigen::Triplet<double>> triplets;
+  auto add = [&](std::size_t a, std::size_t b, const Eigen::Matrix<double, X, X>& block) {
+    for (int c = 0; c < X; ++c)
+      for (int r = 0; r < X; ++r) triplets.emplace_back(X * a + r, X * b + c, block(r, c));
+  };
+  for (std::size_t p = 0; p < sys.pose_count; ++p) add(p, p, sys.pose_diagonal[p]);
+  for (const auto& link : sys.pose_links) {
+    add(link.a, link.b, link.block);
+    add(link.b, link.a, link.block.transpose());
+  }
+  Eigen::VectorXd b = sys.pose_rhs;
+  std::vector<Eigen::LLT<Eigen::Matrix<double, M, M>>> factors;
+  factors.reserve(sys.landmarks.size());
+  for (const auto& terms : sys.landmarks) {
+    factors.push_back(cholesky_or_throw(terms.diagonal, "information of landmark " + std::to_string(pool_.id_at(terms.slot))));
+    const auto& llt = factors.back();
+    std::vector<Eigen::Matrix<double, M, X>> solved;  // Omega_jj^-1 Omega_jp
+    for (const auto& [p, block] : terms.poses) solved.push_back(llt.solve(block.transpose()));
+    const Eigen::Matrix<double, M, 1> solved_rhs = llt.solve(terms.rhs);
+    for (std::size_t a = 0; a < terms.poses.size(); ++a) {
+      const auto& [p, block] = terms.poses[a];
+      b.template segment<X>(X * p) -= block * solved_rhs;
+      for (std::size_t c = 0; c < terms.poses.size(); ++c) add(p, terms.poses[c].first, -(block * solved[c]));
+    }
+  }
+  Eigen::SparseMatrix<double> S(X * sys.pose_count, X * sys.pose_count);
+  S.setFromTriplets(triplets.begin(), triplets.end());
+  const auto eliminated = Clock::now();
+  summary.seconds_eliminate += std::chrono::duration<double>(eliminated - start).count();
+
+  solver_.factorize(S);
+  const Eigen::VectorXd delta_poses = solver_.solve(b);
+  const auto solved_at = Clock::now();
+  summary.seconds_solve += std::chrono::duration<double>(solved_at - eliminated).count();
+
+  Eigen::VectorXd delta(sys.dim());
+  delta.head(delta_poses.size()) = delta_poses;
+  for (std::size_t j = 0; j < sys.landmarks.size(); ++j) {
+    Eigen::Matrix<double, M, 1> r = sys.landmarks[j].rhs;
+    for (const auto& [p, block] : sys.landmarks[j].poses) r -= block.transpose() * delta_poses.template segment<X>(X * p);
+    delta.template segment<M>(delta_poses.size() + M * j) = factors[j].solve(r);
+  }
+  summary.seconds_recover += std::chrono::duration<double>(Clock::now() - solved_at).count();
+  return delta;
+}
+
+template <class Motion, class Sensor>
+Eigen::VectorXd GraphSlam<Motion, Sensor>::solve_full(const Linearization& sys, OptimizationSummary& summary) const {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const Eigen::SparseMatrix<double> A = sys.assemble();
+  Eigen::VectorXd b(sys.dim());
+  b.head(sys.pose_rhs.size()) = sys.pose_rhs;
+  for (std::size_t j = 0; j < sys.landmarks.size(); ++j) b.template segment<M>(sys.pose_rhs.size() + M * j) = sys.landmarks[j].rhs;
+  const auto assembled = Clock::now();
+  summary.seconds_eliminate += std::chrono::duration<double>(assembled - start).count();
+  solver_.factorize(A);
+  const Eigen::VectorXd delta = solver_.solve(b);
+  summary.seconds_solve += std::chrono::duration<double>(Clock::now() - assembled).count();
+  return delta;
+}
+
+template <class Motion, class Sensor>
+void GraphSlam<Motion, Sensor>::apply(const Linearization& sys, const Eigen::VectorXd& delta) {
+  for (std::size_t p = 0; p < sys.pose_count; ++p) poses_[p] = Space::plus(poses_[p], delta.template segment<X>(X * p));
+  const Eigen::Index base = X * static_cast<Eigen::Index>(sys.pose_count);
+  for (std::size_t j = 0; j < sys.landmarks.size(); ++j)
+    landmark_means_.template segment<M>(M * sys.landmarks[j].slot) += delta.template segment<M>(base + M * j);
+}
+
+template <class Motion, class Sensor>
+OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_count, int max_iterations) {
+  using Clock = std::chrono::steady_clock;
+  OptimizationSummary summary;
+  auto timed_linearize = [&] {
+    const auto start = Clock::now();
+    auto sys = linearize(pose_count);
+    summary.seconds_linearize += std::chrono::duration<double>(Clock::now() - start).count();
+    return sys;
+  };
+  Linearization sys = timed_linearize();
+  summary.cost.push_back(sys.cost);
+  for (int iteration = 0; iteration < max_iterations; ++iteration) {
+    const Eigen::VectorXd delta = options_.solver == GraphSolver::landmark_schur ? solve_by_landmark_schur(sys, summary)
+                                                                                  : solve_full(sys, summary);
+    if (!delta.allFinite()) throw numerical_error("GraphSLAM step is not finite");
+    apply(sys, delta);
+    sys = timed_linearize();
+    summary.cost.push_back(sys.cost);
+    ++summary.iterations;
+    const double previous = summary.cost[summary.cost.size() - 2];
+    const double step = delta.size() ? delta.cwiseAbs().maxCoeff() : 0.0;
+    if (step < options_.step_tolerance ||
+        std::abs(previous - sys.cost) <= options_.relative_cost_tolerance * std::max(previous, 1e-300)) {
+      summary.converged = true;
+      break;
+    }
+  }
+  return summary;
+}
+
+/// Poses after pose_count - 1 again by dead reckoning, and landmarks first seen there again by
+/// the inverse model, so that the next sub-part starts from the optimized one.
+template <class Motion, class Sensor>
+void GraphSlam<Motion, Sensor>::reinitialize_after(std::size_t pose_count) {
+  for (std::size_t k = pose_count - 1; k + 1 < poses_.size(); ++k)
+    poses_[k + 1] = motion_.predict(poses_[k], motions_[k].u, motions_[k].dt).x;
+  for (std::size_t slot = 0; slot < measurements_.size(); ++slot) {
+    const auto& first = measurements_[slot].front();
+    if (first.pose >= pose_count)
+      landmark_means_.template segment<M>(M * slot) =
+          initialize_landmark(sensor_, poses_[first.pose], first.z, pool_.id_at(slot)).m;
+  }
+}
+
+/// The thesis's initialization (§4.2.2): optimize the growing graph up to every `window`-th pose a
+/// few times before the whole graph.
+template <class Motion, class Sensor>
+void GraphSlam<Motion, Sensor>::initialize_in_windows() {
+  for (std::size_t end = options_.window; end + 1 < poses_.size(); end += options_.window) {
+    gauss_newton(end + 1, options_.window_iterations);
+    reinitialize_after(end + 1);
+  }
+  windows_done_ = true;
+}
+
+template <class Motion, class Sensor>
+OptimizationSummary GraphSlam<Motion, Sensor>::optimize() {
+  const std::vector<State> poses_before = poses_;
+  const Eigen::VectorXd means_before = landmark_means_;
+  try {
+    if (options_.window > 0 && !windows_done_) initialize_in_windows();
+    OptimizationSummary summary = gauss_newton(poses_.size(), options_.max_iterations);
+    touch();
+    return summary;
+  } catch (...) {
+    poses_ = poses_before;
+    landmark_means_ = means_before;
+    throw;
+  }
+}
+
+template <class Motion, class Sensor>
+void GraphSlam<Motion, Sensor>::warm_start(std::span<const State> poses, const MapEstimate& map) {
+  if (poses.size() != poses_.size())
+    throw invalid_input_error("warm_start: " + std::to_string(poses.size()) + " poses given, the graph has " +
+                              std::to_string(poses_.size()));
+  Eigen::VectorXd means = landmark_means_;
+  for (const auto& landmark : map) means.template segment<M>(M * pool_.slot(landmark.id)) = landmark.mean;
+  for (const auto& pose : poses)
+    if (!Space::is_finite(pose)) throw invalid_input_error("warm_start: a pose contains NaN or Inf");
+  if (!means.allFinite()) throw invalid_input_error("warm_start: a landmark contains NaN or Inf");
+  poses_.assign(poses.begin(), poses.end());
+  landmark_means_ = means;
+  windows_done_ = true;
+  touch();
+}
+
+/// Marginalization of a landmark (thesis Appendix C) at the current estimate: its measurement
+/// factors over (poses P, landmark j) become Lambda = A_PP - A_Pj A_jj^-1 A_jP, eta = b_P - A_Pj A_jj^-1 b_j.
+template <class Motion, class Sensor>
+void GraphSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
+  const std::size_t slot = pool_.slot(id);
+  std::map<std::size_t, std::size_t> index;  // pose -> position in the factor
+  for (const auto& record : measurements_[slot]) index.emplace(record.pose, 0);
+  std::size_t next = 0;
+  for (auto& [pose, position] : index) position = next++;
+  const Eigen::Index n = X * static_cast<Eigen::Index>(index.size());
+  Eigen::MatrixXd A_PP = Eigen::MatrixXd::Zero(n, n), A_Pj = Eigen::MatrixXd::Zero(n, M);
+  Eigen::Matrix<double, M, M> A_jj = Eigen::Matrix<double, M, M>::Zero();
+  Eigen::VectorXd b_P = Eigen::VectorXd::Zero(n);
+  Eigen::Matrix<double, M, 1> b_j = Eigen::Matrix<double, M, 1>::Zero();
+  for (const auto& record : measurements_[slot]) {
+    const auto prediction = sensor_.predict(poses_[record.pose], landmark_mean(slot));
+    const Eigen::Matrix<double, Z, 1> r = -sensor_.residual(record.z, prediction.z);
+    const auto llt = cholesky_or_throw(prediction.Q, "measurement noise Q of landmark " + std::to_string(id));
+    const Eigen::Index at = X * static_cast<Eigen::Index>(index[record.pose]);
+    A_PP.template block<X, X>(at, at) += prediction.J_z_x.transpose() * llt.solve(prediction.J_z_x);
+    A_Pj.template middleRows<X>(at) += prediction.J_z_x.transpose() * llt.solve(prediction.J_z_m);
+    A_jj += prediction.J_z_m.transpose() * llt.solve(prediction.J_z_m);
+    b_P.template segment<X>(at) -= prediction.J_z_x.transpose() * llt.solve(r);
+    b_j -= prediction.J_z_m.transpose() * llt.solve(r);
+  }
+  const auto llt = cholesky_or_throw(A_jj, "information of landmark " + std::to_string(id));
+  LinearFactor factor;
+  for (const auto& [pose, position] : index) {
+    factor.poses.push_back(pose);
+    factor.linearization.push_back(poses_[pose]);
+  }
+  factor.Lambda = symmetrized(A_PP - A_Pj * llt.solve(A_Pj.transpose()));
+  factor.eta = b_P - A_Pj * llt.solve(b_j);
+  linear_factors_.push_back(std::move(factor));
+
+  const auto removal = pool_.remove(id);
+  measurements_[removal.freed_slot] = std::move(measurements_[removal.last_slot]);
+  measurements_.pop_back();
+  landmark_means_.template segment<M>(M * removal.freed_slot) = landmark_means_.template segment<M>(M * removal.last_slot);
+  landmark_means_.conservativeResize(landmark_means_.size() - M);
+  touch();
+}
+
+template <class Motion, class Sensor>
+const SelectedInverse& GraphSlam<Motion, Sensor>::marginals() const {
+  if (!marginals_ || marginals_revision_ != revision_) {
+    marginals_ = std::make_shared<const SelectedInverse>(linearize(poses_.size()).assemble());
+    marginals_revision_ = revision_;
+  }
+  return *marginals_;
+}
+
+template <class Motion, class Sensor>
+auto GraphSlam<Motion, Sensor>::trajectory() const -> std::vector<PoseEstimate> {
+  const auto& Z_ = marginals();
+  std::vector<PoseEstimate> out;
+  out.reserve(poses_.size());
+  for (std::size_t p = 0; p < poses_.size(); ++p) out.push_back({poses_[p], Z_.block(X * p, X)});
+  return out;
+}
+
+template <class Motion, class Sensor>
+auto GraphSlam<Motion, Sensor>::pose() const -> PoseEstimate {
+  const std::size_t p = poses_.size() - 1;
+  return {poses_[p], marginals().block(X * p, X)};
+}
+
+template <class Motion, class Sensor>
+auto GraphSlam<Motion, Sensor>::landmark(LandmarkId id) const -> LandmarkEstimate<M> {
+  const std::size_t slot = pool_.slot(id);
+  const Eigen::Index at = X * static_cast<Eigen::Index>(poses_.size()) + M * static_cast<Eigen::Index>(slot);
+  return {id, landmark_mean(slot), marginals().block(at, M)};
+}
+
+template <class Motion, class Sensor>
+auto GraphSlam<Motion, Sensor>::map() const -> MapEstimate {
+  MapEstimate out;
+  for (LandmarkId id : pool_.ids()) out.push_back(landmark(id));
+  return out;
+}
+
+template <class Motion, class Sensor>
+double GraphSlam<Motion, Sensor>::cost() const {
+  return linearize(poses_.size()).cost;
+}
+
+template <class Motion, class Sensor>
+Eigen::SparseMatrix<double> GraphSlam<Motion, Sensor>::information_matrix() const {
+  return linearize(poses_.size()).assemble();
+}
+
+}  // namespace sextant

@@ -1,0 +1,164 @@
+#pragma once
+/// \file GraphSLAM (thesis §3.6, Appendix B): full SLAM over every pose and landmark in information
+/// form, for any motion and measurement model pair.
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "sextant/core/concepts.hpp"
+#include "sextant/core/gaussian.hpp"
+#include "sextant/core/landmark_pool.hpp"
+#include "sextant/core/selected_inverse.hpp"
+#include "sextant/core/sparse_cholesky.hpp"
+#include "sextant/core/update_result.hpp"
+
+namespace sextant {
+
+/// How the linearized system is solved in each Gauss-Newton iteration.
+enum class GraphSolver {
+  /// The thesis (eqs. 66-73): eliminate every landmark by its own Schur complement, solve the
+  /// reduced pose system by sparse Cholesky, then recover the landmarks.
+  landmark_schur,
+  /// Sparse Cholesky of the whole system (poses and landmarks) with a fill-reducing ordering:
+  /// better when landmarks are seen from very many poses.
+  full,
+};
+
+struct GraphOptions {
+  int max_iterations = 10;
+  double step_tolerance = 1e-8;             ///< stop when max |delta| falls below this
+  double relative_cost_tolerance = 1e-10;   ///< stop when |chi2 change| / chi2 falls below this
+  GraphSolver solver = GraphSolver::landmark_schur;
+  std::size_t window = 0;      ///< thesis §4.2.2: before the first full optimization, optimize growing
+                               ///< sub-parts of `window` steps (0 = dead-reckoning initialization only)
+  int window_iterations = 5;   ///< Gauss-Newton iterations per sub-part
+};
+
+/// What optimize() reports.
+struct OptimizationSummary {
+  int iterations = 0;
+  std::vector<double> cost;   ///< chi2 at the start and after every iteration
+  bool converged = false;
+  double seconds_linearize = 0.0, seconds_eliminate = 0.0, seconds_solve = 0.0, seconds_recover = 0.0;
+};
+
+/// GraphSLAM: records the prior, every motion and every measurement through the filters' face
+/// (predict/update), and optimize() solves for all poses and landmarks by Gauss-Newton,
+/// relinearizing until the step or the cost change is small. New poses start at dead reckoning,
+/// new landmarks at the inverse measurement model. Marginal covariances of every pose and landmark
+/// come from a selected inversion of the sparse information matrix.
+template <class Motion, class Sensor>
+class GraphSlam {
+  static_assert(MotionModel<Motion>,
+                "GraphSlam<Motion, Sensor>: Motion must satisfy sextant::MotionModel (types State, Control, Space, "
+                "constant kDim, and predict(x, u, dt) returning MotionPrediction<State, kDim>)");
+  static_assert(MeasurementModelFor<Sensor, Motion>,
+                "GraphSlam<Motion, Sensor>: Sensor must satisfy sextant::MeasurementModelFor<Sensor, Motion> (fixed-size "
+                "Eigen Landmark and Measurement, predict(x, m) -> MeasurementPrediction, residual(z, z_hat), "
+                "initialize(x, z) -> LandmarkInit)");
+
+ public:
+  using State = typename Motion::State;
+  using Control = typename Motion::Control;
+  using Space = typename Motion::Space;
+  using Landmark = typename Sensor::Landmark;
+  using Measurement = typename Sensor::Measurement;
+  using ObservationType = Observation<Measurement>;
+  static constexpr int X = Motion::kDim;
+  static constexpr int M = landmark_dim_v<Sensor>;
+  static constexpr int Z = measurement_dim_v<Sensor>;
+  using PoseEstimate = Gaussian<State, X>;
+  using MapEstimate = std::vector<LandmarkEstimate<M>>;
+
+  GraphSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, GraphOptions options = {});
+
+  /// Adds a pose x_{k+1} = g(x_k, u, dt) and its motion factor (eqs. 60-61).
+  void predict(const Control& u, double dt);
+  /// Adds measurement factors at the newest pose (eqs. 62-63); new landmarks start at the inverse model.
+  UpdateResult update(std::span<const ObservationType> observations);
+  UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }
+
+  /// Gauss-Newton over all poses and landmarks. Throws numerical_error (estimate unchanged) when
+  /// a noise matrix or the information matrix is not positive definite.
+  OptimizationSummary optimize();
+
+  /// Marginalizes a landmark: its factors become one linear factor over the poses that saw it.
+  void remove_landmark(LandmarkId id);
+
+  /// Replaces the current estimate (e.g. with a filter's trajectory and map) before optimize().
+  void warm_start(std::span<const State> poses, const MapEstimate& map);
+
+  /// The newest pose with its marginal covariance.
+  PoseEstimate pose() const;
+  /// Every pose x_0 .. x_K with its marginal covariance.
+  std::vector<PoseEstimate> trajectory() const;
+  LandmarkEstimate<M> landmark(LandmarkId id) const;
+  MapEstimate map() const;
+  bool has_landmark(LandmarkId id) const { return pool_.contains(id); }
+  std::size_t num_landmarks() const { return pool_.size(); }
+  std::size_t num_poses() const { return poses_.size(); }
+  const std::vector<LandmarkId>& landmark_ids() const { return pool_.ids(); }
+  const std::vector<State>& pose_means() const { return poses_; }
+  /// chi2 of all factors at the current estimate.
+  double cost() const;
+  /// The information matrix of all poses then all landmarks (slot order) at the current estimate.
+  Eigen::SparseMatrix<double> information_matrix() const;
+  const GraphOptions& options() const { return options_; }
+  /// Symbolic analyses done by the sparse solver so far (it keeps one while the pattern is unchanged).
+  int symbolic_analyses() const { return solver_.analyses(); }
+
+ private:
+  struct MotionRecord {
+    Control u;
+    double dt;
+  };
+  struct MeasurementRecord {
+    std::size_t pose;
+    Measurement z;
+  };
+  /// A marginalized landmark: 1/2 d^T Lambda d - eta^T d over the stacked d = minus(x_p, linearization_p).
+  struct LinearFactor {
+    std::vector<std::size_t> poses;
+    std::vector<State> linearization;
+    Eigen::MatrixXd Lambda;
+    Eigen::VectorXd eta;
+  };
+  struct Linearization;  // defined in the implementation
+
+  BetweenFactor<X> motion_factor(std::size_t k) const;
+  Linearization linearize(std::size_t pose_count) const;
+  Eigen::VectorXd solve_by_landmark_schur(const Linearization& system, OptimizationSummary& summary) const;
+  Eigen::VectorXd solve_full(const Linearization& system, OptimizationSummary& summary) const;
+  void apply(const Linearization& system, const Eigen::VectorXd& delta);
+  OptimizationSummary gauss_newton(std::size_t pose_count, int max_iterations);
+  void reinitialize_after(std::size_t pose_count);
+  void initialize_in_windows();
+  const SelectedInverse& marginals() const;
+  Landmark landmark_mean(std::size_t slot) const { return landmark_means_.template segment<M>(M * slot); }
+  void touch() { ++revision_; }
+
+  Motion motion_;
+  Sensor sensor_;
+  GraphOptions options_;
+  PoseEstimate prior_;
+  Eigen::Matrix<double, X, X> prior_information_;
+  std::vector<State> poses_;
+  std::vector<MotionRecord> motions_;                          ///< motions_[k]: pose k -> k + 1
+  std::vector<std::vector<MeasurementRecord>> measurements_;   ///< per landmark slot
+  std::vector<LinearFactor> linear_factors_;
+  Eigen::VectorXd landmark_means_;
+  LandmarkPool pool_;
+  bool windows_done_ = false;
+  std::uint64_t revision_ = 0;
+  mutable SparseCholesky solver_;  ///< keeps the symbolic analysis while the pattern is unchanged
+  mutable std::shared_ptr<const SelectedInverse> marginals_;
+  mutable std::uint64_t marginals_revision_ = ~std::uint64_t{0};
+};
+
+}  // namespace sextant
+
+#include "sextant/backends/detail/graph_slam_impl.hpp"

@@ -1,0 +1,156 @@
+#include "sextant/backends/graph_slam.hpp"
+
+#include <gtest/gtest.h>
+
+#include "sextant/backends/ekf_slam.hpp"
+#include "sextant/eval/runner.hpp"
+#include "sextant/models/beacon_ship_2d.hpp"
+#include "sextant/models/point_in_robot_frame_2d.hpp"
+#include "sextant/models/se2_odometry.hpp"
+#include "sextant/sim/ship_2d.hpp"
+#include "support/batch_least_squares.hpp"
+
+namespace sextant {
+namespace {
+
+using Graph = GraphSlam<BeaconShip2D, BeaconOffset2D>;
+static_assert(SlamBackend<Graph>);
+
+const BeaconShip2D kMotion{0.3, 0.2, HeadingNoise::linearized};
+const BeaconOffset2D kSensor{0.5};
+const Gaussian<Eigen::Vector2d, 2> kPrior{Eigen::Vector2d(1.0, -2.0), 0.04 * Eigen::Matrix2d::Identity()};
+
+class GraphLinear : public ::testing::TestWithParam<GraphSolver> {};
+
+TEST_P(GraphLinear, OneSolveEqualsExactBatchLeastSquaresAndEkfMarginals) {
+  const auto steps = test::random_linear_steps(60, 6, 7);
+  const auto batch = test::solve_linear_ship_problem(kMotion, kSensor, kPrior, steps);
+  Graph graph{kMotion, kSensor, kPrior, {.max_iterations = 1, .solver = GetParam()}};
+  eval::run(graph, steps);
+  const auto summary = graph.optimize();
+  EXPECT_EQ(summary.iterations, 1);
+  const auto trajectory = graph.trajectory();
+  ASSERT_EQ(trajectory.size(), steps.size() + 1);
+  double worst = 0.0;
+  for (std::size_t k = 0; k < trajectory.size(); ++k) {
+    worst = std::max(worst, (trajectory[k].mean - batch.mean.segment<2>(2 * k)).cwiseAbs().maxCoeff());
+    worst = std::max(worst, (trajectory[k].cov - batch.covariance.block(2 * k, 2 * k, 2, 2)).cwiseAbs().maxCoeff());
+  }
+  EkfSlam<BeaconShip2D, BeaconOffset2D> ekf{kMotion, kSensor, kPrior};
+  eval::run(ekf, steps);
+  for (const auto& [id, offset] : batch.landmark_offset) {
+    const auto landmark = graph.landmark(id);
+    worst = std::max(worst, (landmark.mean - batch.mean.segment<2>(offset)).cwiseAbs().maxCoeff());
+    worst = std::max(worst, (landmark.cov - batch.covariance.block(offset, offset, 2, 2)).cwiseAbs().maxCoeff());
+    // Landmarks are static: EKF's final landmark marginals are the full posterior's.
+    worst = std::max(worst, (landmark.cov - ekf.landmark(id).cov).cwiseAbs().maxCoeff());
+    worst = std::max(worst, (landmark.mean - ekf.landmark(id).mean).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst, 1e-9);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothSolvers, GraphLinear, ::testing::Values(GraphSolver::landmark_schur, GraphSolver::full));
+
+TEST(GraphSlam, ShipRunConvergesWithinTenIterationsAndBeatsEkf) {
+  const auto data = sim::simulate_ship_2d({.seed = 4});
+  Graph graph{data.motion, data.sensor, data.prior};
+  eval::run(graph, data.steps);
+  const auto summary = graph.optimize();
+  EXPECT_TRUE(summary.converged);
+  EXPECT_LE(summary.iterations, 10);
+  EXPECT_LT(summary.cost.back(), summary.cost.front());
+  double graph_error = 0.0, ekf_error = 0.0;
+  EkfSlam<BeaconShip2D, BeaconOffset2D> ekf{data.motion, data.sensor, data.prior};
+  const auto record = eval::run(ekf, data.steps);
+  for (std::size_t k = 1; k < data.true_poses.size(); ++k) {
+    graph_error += (graph.pose_means()[k] - data.true_poses[k]).norm();
+    ekf_error += (record.steps[k - 1].pose.mean - data.true_poses[k]).norm();
+  }
+  EXPECT_LT(graph_error, ekf_error);  // smoothing uses the future too
+}
+
+/// A planar robot with odometry and landmarks in its frame: nonlinear, needs relinearization.
+TEST(GraphSlam, Se2ProblemConvergesAndWindowedInitializationAgrees) {
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  const Eigen::Matrix3d odometry_cov = Eigen::Vector3d(0.01, 0.01, 0.004).asDiagonal();
+  PointInRobotFrame2D sensor;
+  sensor.Q = 0.01 * Eigen::Matrix2d::Identity();
+  std::vector<Eigen::Vector2d> landmarks;
+  for (int j = 0; j < 12; ++j) landmarks.emplace_back(10.0 * std::cos(j * 0.52), 10.0 * std::sin(j * 0.52));
+  Eigen::Vector3d truth(8.0, 0.0, std::numbers::pi / 2);
+  std::vector<Step<OdometryIncrement2D, Eigen::Vector2d>> steps;
+  std::vector<Eigen::Vector3d> true_poses{truth};
+  for (int k = 0; k < 150; ++k) {
+    const Eigen::Vector3d delta(0.5, 0.0, 0.0625);
+    truth = Se2Odometry{}.predict(truth, {delta, odometry_cov}, 1.0).x;
+    true_poses.push_back(truth);
+    Step<OdometryIncrement2D, Eigen::Vector2d> step{
+        {delta + Eigen::Vector3d(0.1 * unit(rng), 0.1 * unit(rng), 0.063 * unit(rng)), odometry_cov}, 1.0, {}};
+    for (std::size_t j = 0; j < landmarks.size(); ++j) {
+      const Eigen::Vector2d z = sensor.predict(truth, landmarks[j]).z;
+      if (z.x() > 0.0 && z.norm() < 6.0) step.observations.push_back({j, z + 0.1 * Eigen::Vector2d(unit(rng), unit(rng))});
+    }
+    steps.push_back(step);
+  }
+  const Gaussian<Eigen::Vector3d, 3> prior{true_poses[0], 1e-6 * Eigen::Matrix3d::Identity()};
+  // Converge on the step alone, to 1e-10, so that two runs can be compared to 1e-6.
+  const GraphOptions tight{.max_iterations = 30, .step_tolerance = 1e-10, .relative_cost_tolerance = 0.0};
+  GraphOptions tight_windowed = tight;
+  tight_windowed.window = 30;
+  tight_windowed.window_iterations = 3;
+  GraphSlam<Se2Odometry, PointInRobotFrame2D> plain{Se2Odometry{}, sensor, prior, tight};
+  GraphSlam<Se2Odometry, PointInRobotFrame2D> windowed{Se2Odometry{}, sensor, prior, tight_windowed};
+  eval::run(plain, steps);
+  eval::run(windowed, steps);
+  const double initial_cost = plain.cost();
+  const auto summary = plain.optimize();
+  const auto windowed_summary = windowed.optimize();
+  EXPECT_TRUE(summary.converged);
+  EXPECT_TRUE(windowed_summary.converged);
+  EXPECT_LT(summary.cost.back(), 0.01 * initial_cost);
+  EXPECT_GT(summary.iterations, 2);   // nonlinear: relinearization was needed
+  EXPECT_LE(summary.iterations, 10);  // exact Jacobians (the between factor): quadratic convergence
+  double worst = 0.0, error = 0.0;
+  for (std::size_t k = 0; k < true_poses.size(); ++k) {
+    worst = std::max(worst, Se2Space::minus(plain.pose_means()[k], windowed.pose_means()[k]).cwiseAbs().maxCoeff());
+    error = std::max(error, (plain.pose_means()[k] - true_poses[k]).head<2>().norm());
+  }
+  EXPECT_LT(worst, 1e-6);  // same optimum
+  EXPECT_LT(error, 1.0);
+}
+
+TEST(GraphSlam, RemoveLandmarkKeepsItsInformationAsALinearFactor) {
+  const auto steps = test::random_linear_steps(30, 5, 12);
+  Graph graph{kMotion, kSensor, kPrior};
+  eval::run(graph, steps);
+  graph.optimize();
+  const auto before = graph.trajectory();
+  const LandmarkId removed = graph.landmark_ids()[1];
+  const auto kept = graph.landmark(graph.landmark_ids()[0]);
+  graph.remove_landmark(removed);
+  EXPECT_FALSE(graph.has_landmark(removed));
+  graph.optimize();
+  const auto after = graph.trajectory();
+  for (std::size_t k = 0; k < before.size(); ++k) {
+    EXPECT_LT((after[k].mean - before[k].mean).cwiseAbs().maxCoeff(), 1e-9) << k;
+    EXPECT_LT((after[k].cov - before[k].cov).cwiseAbs().maxCoeff(), 1e-9) << k;
+  }
+  EXPECT_LT((graph.landmark(kept.id).cov - kept.cov).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_THROW(graph.remove_landmark(removed), unknown_landmark_error);
+}
+
+TEST(GraphSlam, SymbolicAnalysisIsReusedWhileThePatternIsUnchanged) {
+  const auto steps = test::random_linear_steps(20, 4, 13);
+  Graph graph{kMotion, kSensor, kPrior, {.max_iterations = 3}};
+  eval::run(graph, steps);
+  graph.optimize();
+  graph.optimize();
+  EXPECT_EQ(graph.symbolic_analyses(), 1);  // every iteration of both calls shared one analysis
+  graph.predict(Eigen::Vector2d(1.0, 0.3), 1.0);
+  graph.optimize();
+  EXPECT_EQ(graph.symbolic_analyses(), 2);  // a new pose changes the pattern
+}
+
+}  // namespace
+}  // namespace sextant
