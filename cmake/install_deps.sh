@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages sextant needs to build, test and benchmark, if any are missing.
 set -euo pipefail
-packages=(cmake make g++ libeigen3-dev libboost-dev libgtest-dev libbenchmark-dev libcli11-dev)
+packages=(cmake make g++ libeigen3-dev libboost-dev libgtest-dev libbenchmark-dev libcli11-dev libsuitesparse-dev libceres-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -29,6 +29,7 @@
 #include "sextant/eval/monte_carlo.hpp"
 #include "sextant/eval/runner.hpp"
 #include "sextant/io/csv_writer.hpp"
+#include "sextant/io/isam_reader.hpp"
 #include "sextant/io/tum_writer.hpp"
 #include "sextant/sim/ship_2d.hpp"
 #include "sextant/testing/model_checks.hpp"

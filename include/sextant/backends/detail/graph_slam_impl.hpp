@@ -270,6 +270,25 @@ void GraphSlam<Motion, Sensor>::apply(const Linearization& sys, const Eigen::Vec
     landmark_means_.template segment<M>(M * sys.landmarks[j].slot) += delta.template segment<M>(base + M * j);
 }
 
+/// One step of the (damped) normal equations: lambda > 0 adds lambda diag(Omega) (Marquardt).
+template <class Motion, class Sensor>
+Eigen::VectorXd GraphSlam<Motion, Sensor>::solve(const Linearization& sys, double lambda,
+                                                 OptimizationSummary& summary) const {
+  const Linearization* system = &sys;
+  Linearization damped;
+  if (lambda > 0.0) {
+    damped = sys;
+    for (auto& block : damped.pose_diagonal) block.diagonal() *= 1.0 + lambda;
+    for (auto& terms : damped.landmarks) terms.diagonal.diagonal() *= 1.0 + lambda;
+    system = &damped;
+  }
+  bool schur = options_.solver == GraphSolver::landmark_schur;
+  if (options_.solver == GraphSolver::automatic)
+    schur = M * system->landmarks.size() > X * system->pose_count;
+  return schur ? solve_by_landmark_schur(*system, summary) : solve_full(*system, summary);
+}
+
+/// Gauss-Newton (or Levenberg-Marquardt) until the step or the relative change of chi2 is small.
 template <class Motion, class Sensor>
 OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_count, int max_iterations) {
   using Clock = std::chrono::steady_clock;
@@ -282,15 +301,26 @@ OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_cou
   };
   Linearization sys = timed_linearize();
   summary.cost.push_back(sys.cost);
+  double lambda = options_.levenberg_marquardt ? options_.initial_lambda : 0.0;
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
-    const Eigen::VectorXd delta = options_.solver == GraphSolver::landmark_schur ? solve_by_landmark_schur(sys, summary)
-                                                                                  : solve_full(sys, summary);
+    const Eigen::VectorXd delta = solve(sys, lambda, summary);
     if (!delta.allFinite()) throw numerical_error("GraphSLAM step is not finite");
+    const std::vector<State> poses_before = lambda > 0.0 ? poses_ : std::vector<State>{};
+    const Eigen::VectorXd means_before = lambda > 0.0 ? landmark_means_ : Eigen::VectorXd{};
     apply(sys, delta);
-    sys = timed_linearize();
-    summary.cost.push_back(sys.cost);
+    Linearization next = timed_linearize();
     ++summary.iterations;
-    const double previous = summary.cost[summary.cost.size() - 2];
+    if (lambda > 0.0 && next.cost > sys.cost) {  // rejected: back to where we were, damp more
+      poses_ = poses_before;
+      landmark_means_ = means_before;
+      lambda *= 10.0;
+      summary.cost.push_back(sys.cost);
+      continue;
+    }
+    if (lambda > 0.0) lambda = std::max(lambda / 10.0, 1e-12);
+    summary.cost.push_back(next.cost);
+    const double previous = sys.cost;
+    sys = std::move(next);
     const double step = delta.size() ? delta.cwiseAbs().maxCoeff() : 0.0;
     if (step < options_.step_tolerance ||
         std::abs(previous - sys.cost) <= options_.relative_cost_tolerance * std::max(previous, 1e-300)) {

@@ -1,0 +1,65 @@
+// GraphSLAM on real and benchmark data sets from ../shared/data; skipped when they are absent.
+#include <gtest/gtest.h>
+
+#include "sextant/backends/graph_slam.hpp"
+#include "sextant/io/isam_reader.hpp"
+#include "support/shared_data.hpp"
+
+namespace sextant {
+namespace {
+
+using PlanarGraph = GraphSlam<Se2Odometry, PointInRobotFrame2D>;
+
+PlanarGraph load(const io::PlanarDataset& data, GraphOptions options) {
+  PointInRobotFrame2D sensor;
+  sensor.Q = data.landmark_cov;
+  PlanarGraph graph{Se2Odometry{}, sensor, {Eigen::Vector3d::Zero(), 1e-6 * Eigen::Matrix3d::Identity()}, options};
+  graph.update(data.initial_observations);
+  for (const auto& step : data.steps) {
+    graph.predict(step.control, step.dt);
+    graph.update(step.observations);
+  }
+  return graph;
+}
+
+TEST(GraphSlamData, CityTrees10000AgainstItsGroundTruth) {
+  const auto path = test::shared_data("city_trees/cityTrees10000.txt");
+  const auto truth_path = test::shared_data("city_trees/cityTrees10000_groundtruth.txt");
+  SEXTANT_REQUIRE_DATA(path);
+  SEXTANT_REQUIRE_DATA(truth_path);
+  auto graph = load(io::read_isam_2d(path, io::IsamNoise::square_root_information), {});
+  const auto summary = graph.optimize();
+  EXPECT_TRUE(summary.converged);
+  EXPECT_LE(summary.iterations, 10);
+  const auto truth = io::ground_truth_from_noise_free(io::read_isam_2d(truth_path, io::IsamNoise::square_root_information));
+  ASSERT_EQ(truth.poses.size(), graph.num_poses());
+  double pose_sq = 0.0, landmark_sq = 0.0;
+  for (std::size_t k = 0; k < truth.poses.size(); ++k) pose_sq += (graph.pose_means()[k] - truth.poses[k]).head<2>().squaredNorm();
+  for (const auto& landmark : graph.map()) landmark_sq += (landmark.mean - truth.landmarks.at(landmark.id)).squaredNorm();
+  const double pose_rmse = std::sqrt(pose_sq / truth.poses.size());
+  const double landmark_rmse = std::sqrt(landmark_sq / graph.num_landmarks());
+  std::printf("cityTrees10000: %d iterations, chi2 %.2f, pose RMSE %.4f m, landmark RMSE %.4f m\n", summary.iterations,
+              summary.cost.back(), pose_rmse, landmark_rmse);
+  EXPECT_LT(pose_rmse, 1.0);  // measured 0.912
+  EXPECT_LT(landmark_rmse, 1.0);  // measured 0.780
+}
+
+TEST(GraphSlamData, VictoriaParkConvergesWithWindowedInitialization) {
+  const auto path = test::shared_data("victoria_park/victoria_park.txt");
+  SEXTANT_REQUIRE_DATA(path);
+  const auto data = io::read_isam_2d(path, io::IsamNoise::covariance);
+  auto graph = load(data, {.max_iterations = 20, .window = 200, .window_iterations = 3});
+  const auto summary = graph.optimize();
+  EXPECT_TRUE(summary.converged);
+  // A consistent solution has chi2 near its degrees of freedom (residuals minus unknowns).
+  std::size_t observations = data.initial_observations.size();
+  for (const auto& step : data.steps) observations += step.observations.size();
+  const double dof = 3.0 * data.steps.size() + 2.0 * observations - 3.0 * data.steps.size() - 2.0 * graph.num_landmarks();
+  std::printf("Victoria Park: %d iterations, chi2 %.1f for %.0f degrees of freedom, %zu landmarks\n", summary.iterations,
+              summary.cost.back(), dof, graph.num_landmarks());
+  EXPECT_GT(summary.cost.back(), 0.5 * dof);
+  EXPECT_LT(summary.cost.back(), 1.5 * dof);
+}
+
+}  // namespace
+}  // namespace sextant

@@ -1,0 +1,91 @@
+#include "sextant/io/isam_reader.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace sextant::io {
+namespace {
+
+std::string write_file(const std::string& name, const std::string& text) {
+  const auto path = (std::filesystem::temp_directory_path() / ("sextant_isam_" + name + ".txt")).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(IsamReader, ReadsSquareRootInformationRecords) {
+  const auto path = write_file("sqrt", "EDGE2 0 1 1 0 0.5 50 0 0 50 0 100\n"
+                                       "LANDMARK 1 7 2 -1 10 0 10\n"
+                                       "# a comment\n\n"
+                                       "EDGE2 1 2 1 0 0 50 0 0 50 0 100\n");
+  const auto data = read_isam_2d(path, IsamNoise::square_root_information);
+  ASSERT_EQ(data.steps.size(), 2u);
+  EXPECT_EQ(data.pose_ids, (std::vector<long long>{0, 1, 2}));
+  EXPECT_TRUE(data.steps[0].control.delta.isApprox(Eigen::Vector3d(1.0, 0.0, 0.5)));
+  EXPECT_TRUE(data.steps[0].control.cov.isApprox(Eigen::Vector3d(1.0 / 2500, 1.0 / 2500, 1.0 / 10000).asDiagonal().toDenseMatrix()));
+  ASSERT_EQ(data.steps[0].observations.size(), 1u);
+  EXPECT_EQ(data.steps[0].observations[0].landmark_id, 7u);
+  EXPECT_TRUE(data.landmark_cov.isApprox(0.01 * Eigen::Matrix2d::Identity()));
+}
+
+TEST(IsamReader, ReadsCovarianceRecordsAndObservationsOfTheFirstPose) {
+  const auto path = write_file("cov", "LANDMARK 4 5 11.5 -3.2 0.4 0.1 0.4\n"
+                                      "ODOMETRY 4 6 0.08 0 0.001 0.0001 0 0 4e-06 0 4e-06\n");
+  const auto data = read_isam_2d(path, IsamNoise::covariance);
+  EXPECT_EQ(data.pose_ids, (std::vector<long long>{4, 6}));
+  ASSERT_EQ(data.initial_observations.size(), 1u);
+  EXPECT_EQ(data.landmark_cov(0, 1), 0.1);
+  EXPECT_EQ(data.steps[0].control.cov(1, 1), 4e-06);
+}
+
+TEST(IsamReader, GroundTruthComposesOdometryAndLandmarks) {
+  const auto path = write_file("truth", "EDGE2 0 1 1 0 1.5707963267948966 50 0 0 50 0 100\n"
+                                        "LANDMARK 1 3 2 0 10 0 10\n");
+  const auto truth = ground_truth_from_noise_free(read_isam_2d(path, IsamNoise::square_root_information));
+  EXPECT_TRUE(truth.poses[1].isApprox(Eigen::Vector3d(1.0, 0.0, 1.5707963267948966)));
+  EXPECT_TRUE(truth.landmarks.at(3).isApprox(Eigen::Vector2d(1.0, 2.0)));
+}
+
+struct Malformed {
+  const char* name;
+  const char* text;
+  const char* message;  // what the error must say, after "file:line"
+};
+
+class IsamReaderRejects : public ::testing::TestWithParam<Malformed> {};
+
+TEST_P(IsamReaderRejects, NamingTheLine) {
+  const auto& c = GetParam();
+  const auto path = write_file(c.name, c.text);
+  try {
+    read_isam_2d(path, IsamNoise::square_root_information);
+    FAIL() << "expected parse_error";
+  } catch (const parse_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path + ":2:"), std::string::npos) << what;
+    EXPECT_NE(what.find(c.message), std::string::npos) << what;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    MalformedFiles, IsamReaderRejects,
+    ::testing::Values(
+        Malformed{"tag", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nVERTEX 1 2 3\n", "unknown record 'VERTEX'"},
+        Malformed{"count", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 1 2 1 0 0 50 0 0 50 0\n", "needs 11 values, found 10"},
+        Malformed{"number", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 1 2 x 0 10 0 10\n", "'x' is not a finite number"},
+        Malformed{"nan", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 1 2 nan 0 10 0 10\n", "'nan' is not a finite number"},
+        Malformed{"chain", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 5 6 1 0 0 50 0 0 50 0 100\n", "does not continue the chain"},
+        Malformed{"old_pose", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 0 2 1 0 10 0 10\n", "newest pose is 1"},
+        Malformed{"singular", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 1 2 1 0 0 50 0 0 0 0 100\n", "singular"},
+        Malformed{"noise", "LANDMARK 0 1 1 0 10 0 10\nLANDMARK 0 2 1 0 20 0 20\n", "landmark noise differs"},
+        Malformed{"twice", "LANDMARK 0 1 1 0 10 0 10\nLANDMARK 0 1 1 0 10 0 10\n", "seen twice"}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+TEST(IsamReader, MissingOrEmptyFile) {
+  EXPECT_THROW(read_isam_2d("/nonexistent/file.txt", IsamNoise::covariance), parse_error);
+  EXPECT_THROW(read_isam_2d(write_file("empty", "# nothing\n"), IsamNoise::covariance), parse_error);
+}
+
+}  // namespace
+}  // namespace sextant::io
