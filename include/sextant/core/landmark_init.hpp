@@ -5,16 +5,19 @@
 #include <string>
 
 #include "sextant/core/error.hpp"
+#include "sextant/core/gaussian.hpp"
 #include "sextant/core/observation.hpp"
 
 namespace sextant {
 
-/// sensor.initialize(x, z) for landmark `id`; throws numerical_error when the model returns NaN or Inf.
+/// sensor.initialize(x, z) for landmark `id`; throws numerical_error when the model returns NaN or
+/// Inf or a measurement noise Q that is not positive definite.
 template <class Sensor, class State, class Measurement>
 auto initialize_landmark(const Sensor& sensor, const State& x, const Measurement& z, LandmarkId id) {
   auto init = sensor.initialize(x, z);
   if (!init.m.allFinite() || !init.J_m_x.allFinite() || !init.J_m_z.allFinite() || !init.Q.allFinite())
     throw numerical_error("inverse measurement model returned NaN or Inf for landmark " + std::to_string(id));
+  cholesky_or_throw(init.Q, "measurement noise Q of new landmark " + std::to_string(id));
   return init;
 }
 

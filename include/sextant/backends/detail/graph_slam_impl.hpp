@@ -93,9 +93,17 @@ UpdateResult GraphSlam<Motion, Sensor>::update(std::span<const ObservationType> 
   require_valid_observations(observations);
   const auto [known, fresh] = split_known_and_new(pool_, observations);
   const std::size_t pose = poses_.size() - 1;
+  // Check every new factor now, so that bad noise is reported where it enters, not at optimize().
+  for (const auto& observation : known) {
+    const auto prediction = sensor_.predict(poses_[pose], landmark_mean(pool_.slot(observation.landmark_id)));
+    cholesky_or_throw(prediction.Q, "measurement noise Q of landmark " + std::to_string(observation.landmark_id));
+  }
   std::vector<LandmarkInit<M, X, Z>> inits;
-  for (const auto& observation : fresh)
+  for (const auto& observation : fresh) {
     inits.push_back(initialize_landmark(sensor_, poses_[pose], observation.z, observation.landmark_id));
+    cholesky_or_throw(sensor_.predict(poses_[pose], inits.back().m).Q,
+                      "measurement noise Q of landmark " + std::to_string(observation.landmark_id));
+  }
   for (const auto& observation : known) measurements_[pool_.slot(observation.landmark_id)].push_back({pose, observation.z});
   for (std::size_t i = 0; i < fresh.size(); ++i) {
     pool_.add(fresh[i].landmark_id);
