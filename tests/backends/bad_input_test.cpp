@@ -157,7 +157,9 @@ void expect_not_positive_definite_and_no_change(Backend& backend, const std::vec
 }
 
 TYPED_TEST(BadInput, NewLandmarkWithIndefiniteNoise) {
-  auto backend = TypeParam::make(BeaconShip2D{}, BrokenNoiseSensor{.initialize_too = true}, kPrior);
+  BrokenNoiseSensor sensor;
+  sensor.initialize_too = true;
+  auto backend = TypeParam::make(BeaconShip2D{}, sensor, kPrior);
   backend.update(std::vector<Obs>{{1, {1.0, 0.0}}});
   expect_not_positive_definite_and_no_change(backend, {{1, {1.1, 0.0}}, {2, {2e5, 0.0}}, {3, {0.0, 1.0}}});
   EXPECT_FALSE(backend.has_landmark(2));
