@@ -145,6 +145,26 @@ TEST(GraphSlam, RemoveLandmarkKeepsItsInformationAsALinearFactor) {
   EXPECT_THROW(graph.remove_landmark(removed), unknown_landmark_error);
 }
 
+TEST(GraphSlam, WarmStartFromAFilterReachesTheSameOptimum) {
+  const auto data = sim::simulate_ship_2d({.seed = 6, .num_steps = 300});
+  EkfSlam<BeaconShip2D, BeaconOffset2D> ekf{data.motion, data.sensor, data.prior};
+  const auto record = eval::run(ekf, data.steps);
+  std::vector<Eigen::Vector2d> poses{data.prior.mean};
+  for (const auto& step : record.steps) poses.push_back(step.pose.mean);
+  Graph cold{data.motion, data.sensor, data.prior}, warm{data.motion, data.sensor, data.prior};
+  eval::run(cold, data.steps);
+  eval::run(warm, data.steps);
+  warm.warm_start(poses, ekf.map());
+  EXPECT_LT(warm.cost(), cold.cost());  // the filter's estimate is a better start than dead reckoning
+  cold.optimize();
+  warm.optimize();
+  double worst = 0.0;
+  for (std::size_t k = 0; k < poses.size(); ++k)
+    worst = std::max(worst, (warm.pose_means()[k] - cold.pose_means()[k]).cwiseAbs().maxCoeff());
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_THROW(warm.warm_start(std::vector<Eigen::Vector2d>(3), ekf.map()), invalid_input_error);
+}
+
 TEST(GraphSlam, SymbolicAnalysisIsReusedWhileThePatternIsUnchanged) {
   const auto steps = test::random_linear_steps(20, 4, 13);
   Graph graph{kMotion, kSensor, kPrior, {.max_iterations = 3}};
