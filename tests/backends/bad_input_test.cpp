@@ -7,6 +7,7 @@
 #include "sextant/backends/ekf_slam.hpp"
 #include "sextant/backends/seif_slam.hpp"
 #include "sextant/backends/graph_slam.hpp"
+#include "sextant/backends/fast_slam.hpp"
 #include "sextant/eval/runner.hpp"
 #include "sextant/models/beacon_ship_2d.hpp"
 #include "support/batch_least_squares.hpp"
@@ -53,6 +54,19 @@ struct GraphAutomatic {
   }
 };
 
+struct FastSlamOne {
+  template <class Motion, class Sensor>
+  static auto make(Motion motion, Sensor sensor, const Gaussian<Eigen::Vector2d, 2>& prior) {
+    return FastSlam<Motion, Sensor>{motion, sensor, prior, {.particles = 20, .version = FastSlamVersion::v1}};
+  }
+};
+struct FastSlamTwo {
+  template <class Motion, class Sensor>
+  static auto make(Motion motion, Sensor sensor, const Gaussian<Eigen::Vector2d, 2>& prior) {
+    return FastSlam<Motion, Sensor>{motion, sensor, prior, {.particles = 20, .version = FastSlamVersion::v2}};
+  }
+};
+
 template <class Backend>
 struct Snapshot {
   explicit Snapshot(const Backend& backend) : pose(backend.pose()), map(backend.map()) {}
@@ -94,7 +108,8 @@ class BadInput : public ::testing::Test {
   Backend backend_;
 };
 
-using Configs = ::testing::Types<EkfBatch, EkfSequential, SeifSparsified, SeifExactRecovery, GraphAutomatic>;
+using Configs =
+    ::testing::Types<EkfBatch, EkfSequential, SeifSparsified, SeifExactRecovery, GraphAutomatic, FastSlamOne, FastSlamTwo>;
 TYPED_TEST_SUITE(BadInput, Configs);
 
 TYPED_TEST(BadInput, NaNOrInfControl) {

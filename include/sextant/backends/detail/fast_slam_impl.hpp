@@ -1,0 +1,350 @@
+#pragma once
+// Bodies of FastSlam (see ../fast_slam.hpp).
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <numeric>
+#include <string>
+
+#include "sextant/core/landmark_init.hpp"
+#include "sextant/core/validation.hpp"
+
+namespace sextant {
+
+namespace detail {
+/// log N(nu; 0, S) from the Cholesky factor of S.
+template <class Llt, class Vector>
+double log_gaussian(const Llt& llt, const Vector& nu) {
+  const double log_det = 2.0 * llt.matrixL().toDenseMatrix().diagonal().array().log().sum();
+  return -0.5 * (mahalanobis_squared(llt, nu) + log_det + nu.size() * std::log(2.0 * std::numbers::pi));
+}
+}  // namespace detail
+
+template <class Motion, class Sensor, template <class> class Map>
+FastSlam<Motion, Sensor, Map>::FastSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, FastSlamOptions options)
+    : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), rng_(options.seed) {
+  if (options_.particles == 0) throw invalid_input_error("FastSlamOptions: particles must be > 0");
+  if (!(options_.resample_threshold >= 0.0 && options_.resample_threshold <= 1.0))
+    throw invalid_input_error("FastSlamOptions: resample_threshold must be in [0, 1]");
+  if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
+  cholesky_or_throw(prior.cov, "prior covariance");
+  particles_.resize(options_.particles);
+  for (auto& particle : particles_) particle.x = sample(prior.mean, prior.cov);
+}
+
+/// x = plus(mean, L n), n ~ N(0, I), with cov = L L^T from an LDL^T factorization (semi-definite allowed).
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::sample(const State& mean, const Eigen::Matrix<double, X, X>& cov) -> State {
+  const Eigen::LDLT<Eigen::Matrix<double, X, X>> ldlt(cov);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  Eigen::Matrix<double, X, 1> n;
+  for (int i = 0; i < X; ++i) n(i) = unit(rng_) * std::sqrt(std::max(ldlt.vectorD()(i), 0.0));
+  const Eigen::Matrix<double, X, 1> d = ldlt.transpositionsP().transpose() * (ldlt.matrixL() * n);
+  return Space::plus(mean, d);
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+void FastSlam<Motion, Sensor, Map>::predict(const Control& u, double dt) {
+  require_finite(u, "control");
+  require_positive_time_step(dt);
+  for (const auto& particle : particles_) {  // check the model once per particle before any change
+    const auto p = motion_.predict(particle.x, u, dt);
+    if (!Space::is_finite(p.x) || !p.R.allFinite()) throw numerical_error("motion model returned NaN or Inf");
+  }
+  if (options_.version == FastSlamVersion::v2) {
+    apply_pending_motion_v1();  // two predicts in a row: the first one is sampled plainly
+    pending_.push_back({u, dt});
+    return;
+  }
+  pending_.push_back({u, dt});
+  apply_pending_motion_v1();
+}
+
+/// FastSLAM 1.0 (eq. 74): every particle samples x ~ N(g(x, u), R).
+template <class Motion, class Sensor, template <class> class Map>
+void FastSlam<Motion, Sensor, Map>::apply_pending_motion_v1() {
+  for (const auto& motion : pending_)
+    for (auto& particle : particles_) {
+      const auto p = motion_.predict(particle.x, motion.u, motion.dt);
+      particle.x = sample(p.x, p.R);
+    }
+  pending_.clear();
+}
+
+/// One landmark EKF update with the particle's pose (eqs. 75-78, Joseph form); returns the log
+/// likelihood log N(nu; 0, S), S = H_m Sigma_m H_m^T + Q (eqs. 79-81).
+template <class Motion, class Sensor, template <class> class Map>
+double FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::size_t index, const Measurement& z,
+                                                      bool unassociated) {
+  auto& map = unassociated ? particle.unassociated : particle.landmarks;
+  const LandmarkGaussian<M>& L = map[index];
+  const auto pred = sensor_.predict(particle.x, L.mean);
+  const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(z, pred.z);
+  const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
+  const auto llt = cholesky_or_throw(S, "landmark innovation covariance");
+  const Eigen::Matrix<double, M, Z> K = llt.solve(pred.J_z_m * L.cov).transpose();
+  const Eigen::Matrix<double, M, M> I_KH = Eigen::Matrix<double, M, M>::Identity() - K * pred.J_z_m;
+  LandmarkGaussian<M> updated{L.mean + K * nu, symmetrized(I_KH * L.cov * I_KH.transpose() + K * pred.Q * K.transpose()), true};
+  const double log_likelihood = detail::log_gaussian(llt, nu);
+  if (!updated.mean.allFinite() || !updated.cov.allFinite() || !std::isfinite(log_likelihood))
+    throw numerical_error("landmark update is not finite");
+  map.set(index, std::move(updated));
+  return log_likelihood;
+}
+
+/// FastSLAM 2.0 proposal (eqs. 82-92), in Kalman form so that R may be singular: starting from
+/// N(g(x, u), R), each observation of a known landmark corrects the pose Gaussian with
+/// S = H_x Sigma H_x^T + H_m Sigma_m H_m^T + Q; the weight gains log N(nu; 0, S) (eq. 93, chained
+/// over the observations); the pose is then sampled from the result.
+template <class Motion, class Sensor, template <class> class Map>
+void FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const State& predicted,
+                                                       const Eigen::Matrix<double, X, X>& R,
+                                                       std::span<const ObservationType> known) {
+  State mean = predicted;
+  Eigen::Matrix<double, X, X> cov = R;
+  for (const auto& observation : known) {
+    const LandmarkGaussian<M>& L = particle.landmarks[index_.at(observation.landmark_id)];
+    const auto pred = sensor_.predict(mean, L.mean);
+    const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(observation.z, pred.z);
+    const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_x * cov * pred.J_z_x.transpose() +
+                                                      pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
+    const auto llt = cholesky_or_throw(S, "proposal innovation covariance");
+    const Eigen::Matrix<double, X, Z> K = llt.solve(pred.J_z_x * cov).transpose();
+    particle.log_weight += detail::log_gaussian(llt, nu);
+    mean = Space::plus(mean, K * nu);
+    cov = symmetrized((Eigen::Matrix<double, X, X>::Identity() - K * pred.J_z_x) * cov);
+  }
+  particle.x = sample(mean, cov);
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationType> observations) {
+  require_valid_observations(observations);
+  std::vector<ObservationType> known, fresh;
+  for (const auto& observation : observations)
+    (index_.contains(observation.landmark_id) ? known : fresh).push_back(observation);
+  // Work on copies (O(N) with shared maps) and commit at the end: the strong guarantee.
+  std::vector<Particle> next = particles_;
+  const auto rng_before = rng_;
+  try {
+    for (auto& particle : next) {
+      if (options_.version == FastSlamVersion::v2 && !pending_.empty()) {
+        const auto p = motion_.predict(particle.x, pending_.back().u, pending_.back().dt);
+        sample_v2_proposal(particle, p.x, p.R, known);
+        for (const auto& observation : known) update_landmark(particle, index_.at(observation.landmark_id), observation.z, false);
+      } else {
+        for (const auto& observation : known)
+          particle.log_weight += update_landmark(particle, index_.at(observation.landmark_id), observation.z, false);
+      }
+      for (const auto& observation : fresh) {
+        const auto init = initialize_landmark(sensor_, particle.x, observation.z, observation.landmark_id);
+        particle.landmarks.push_back({init.m, symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose()), true});
+      }
+    }
+  } catch (...) {
+    rng_ = rng_before;
+    throw;
+  }
+  particles_ = std::move(next);
+  pending_.clear();
+  for (const auto& observation : fresh) {
+    index_.emplace(observation.landmark_id, id_of_index_.size());
+    id_of_index_.push_back(observation.landmark_id);
+  }
+  normalize_and_resample();
+  return {known.size(), fresh.size(), {}};
+}
+
+/// Thesis §7.2: per particle, each measurement goes to the landmark of that particle with the
+/// largest likelihood, or starts a new one when even the best is beyond the new-landmark gate. With
+/// FastSLAM 2.0 the association is decided inside the proposal, so the innovation covariance
+/// includes the pose's motion uncertainty (S = H_x Sigma_x H_x^T + H_m Sigma_m H_m^T + Q), and the
+/// pose is sampled after the associated measurements have shaped it.
+template <class Motion, class Sensor, template <class> class Map>
+UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const Measurement> measurements) {
+  for (const auto& z : measurements) require_finite(z, "unassociated measurement");
+  std::vector<Particle> next = particles_;
+  const auto rng_before = rng_;
+  const bool proposal = options_.version == FastSlamVersion::v2 && !pending_.empty();
+  constexpr std::size_t kNew = ~std::size_t{0};
+  try {
+    for (auto& particle : next) {
+      State mean = particle.x;
+      Eigen::Matrix<double, X, X> cov = Eigen::Matrix<double, X, X>::Zero();
+      for (const auto& motion : pending_) {
+        const auto p = motion_.predict(mean, motion.u, motion.dt);
+        mean = p.x;
+        cov = proposal ? Eigen::Matrix<double, X, X>(p.R) : cov;
+        if (!proposal) mean = sample(p.x, p.R);
+      }
+      std::vector<std::size_t> match(measurements.size(), kNew);
+      for (std::size_t i = 0; i < measurements.size(); ++i) {
+        double best_nis = options_.new_landmark_nis;
+        for (std::size_t j = 0; j < particle.unassociated.size(); ++j) {
+          const auto& L = particle.unassociated[j];
+          if (!L.alive) continue;
+          const auto pred = sensor_.predict(mean, L.mean);
+          const Eigen::Matrix<double, Z, Z> S = pred.J_z_x * cov * pred.J_z_x.transpose() +
+                                                pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q;
+          const double nis =
+              mahalanobis_squared(cholesky_or_throw(S, "association innovation"), sensor_.residual(measurements[i], pred.z));
+          if (nis < best_nis) best_nis = nis, match[i] = j;
+        }
+        if (proposal && match[i] != kNew) {  // fold the associated measurement into the proposal
+          const auto& L = particle.unassociated[match[i]];
+          const auto pred = sensor_.predict(mean, L.mean);
+          const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_x * cov * pred.J_z_x.transpose() +
+                                                            pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
+          const auto llt = cholesky_or_throw(S, "proposal innovation covariance");
+          const Eigen::Matrix<double, X, Z> K = llt.solve(pred.J_z_x * cov).transpose();
+          const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(measurements[i], pred.z);
+          particle.log_weight += detail::log_gaussian(llt, nu);
+          mean = Space::plus(mean, K * nu);
+          cov = symmetrized((Eigen::Matrix<double, X, X>::Identity() - K * pred.J_z_x) * cov);
+        }
+      }
+      particle.x = proposal ? sample(mean, cov) : mean;
+      for (std::size_t i = 0; i < measurements.size(); ++i) {
+        if (match[i] != kNew) {
+          const double log_likelihood = update_landmark(particle, match[i], measurements[i], true);
+          if (!proposal) particle.log_weight += log_likelihood;
+          continue;
+        }
+        const auto init = initialize_landmark(sensor_, particle.x, measurements[i], 0);
+        particle.unassociated.push_back({init.m, symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose()), true});
+        // A new landmark weighs as a measurement on the gate's edge (the p0 of Montemerlo et al.).
+        particle.log_weight += detail::log_gaussian(cholesky_or_throw(init.Q, "measurement noise"),
+                                                    Eigen::Matrix<double, Z, 1>::Zero().eval()) -
+                               0.5 * options_.new_landmark_nis;
+      }
+    }
+  } catch (...) {
+    rng_ = rng_before;
+    throw;
+  }
+  particles_ = std::move(next);
+  pending_.clear();
+  normalize_and_resample();
+  return {measurements.size(), 0, {}};
+}
+
+/// Normalizes the log weights (log-sum-exp) and resamples by the low-variance sampler (§3.7.4)
+/// when the effective sample size falls below the threshold.
+template <class Motion, class Sensor, template <class> class Map>
+void FastSlam<Motion, Sensor, Map>::normalize_and_resample() {
+  const double max_log = std::max_element(particles_.begin(), particles_.end(), [](const auto& a, const auto& b) {
+                           return a.log_weight < b.log_weight;
+                         })->log_weight;
+  double sum = 0.0;
+  for (const auto& p : particles_) sum += std::exp(p.log_weight - max_log);
+  const double log_total = max_log + std::log(sum);
+  for (auto& p : particles_) p.log_weight -= log_total;
+  const double n = static_cast<double>(particles_.size());
+  if (effective_sample_size() >= options_.resample_threshold * n) return;
+  const auto w = weights();
+  std::vector<Particle> resampled;
+  resampled.reserve(particles_.size());
+  const double step = 1.0 / n;
+  double u = std::uniform_real_distribution<double>(0.0, step)(rng_), cumulative = w[0];
+  std::size_t i = 0;
+  for (std::size_t m = 0; m < particles_.size(); ++m, u += step) {
+    while (u > cumulative && i + 1 < w.size()) cumulative += w[++i];
+    resampled.push_back(particles_[i]);  // O(1) map copy with PersistentArray
+    resampled.back().log_weight = -std::log(n);
+  }
+  particles_ = std::move(resampled);
+  ++resamplings_;
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+std::vector<double> FastSlam<Motion, Sensor, Map>::weights() const {
+  std::vector<double> w;
+  w.reserve(particles_.size());
+  for (const auto& p : particles_) w.push_back(std::exp(p.log_weight));
+  const double sum = std::accumulate(w.begin(), w.end(), 0.0);
+  for (double& v : w) v /= sum;
+  return w;
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+double FastSlam<Motion, Sensor, Map>::effective_sample_size() const {
+  double sum_sq = 0.0;
+  for (double v : weights()) sum_sq += v * v;
+  return 1.0 / sum_sq;
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+std::size_t FastSlam<Motion, Sensor, Map>::best_particle() const {
+  return static_cast<std::size_t>(std::max_element(particles_.begin(), particles_.end(),
+                                                   [](const auto& a, const auto& b) { return a.log_weight < b.log_weight; }) -
+                                  particles_.begin());
+}
+
+/// Weighted mean and covariance of the poses, in the tangent space at the best particle (a pose
+/// not yet sampled by FastSLAM 2.0 counts at its predicted mean).
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::pose() const -> PoseEstimate {
+  const auto w = weights();
+  auto pose_of = [&](const Particle& p) {
+    State x = p.x;
+    for (const auto& motion : pending_) x = motion_.predict(x, motion.u, motion.dt).x;
+    return x;
+  };
+  const State reference = pose_of(particles_[best_particle()]);
+  Eigen::Matrix<double, X, 1> mean_d = Eigen::Matrix<double, X, 1>::Zero();
+  std::vector<Eigen::Matrix<double, X, 1>> d;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    d.push_back(Space::minus(pose_of(particles_[i]), reference));
+    mean_d += w[i] * d.back();
+  }
+  Eigen::Matrix<double, X, X> cov = Eigen::Matrix<double, X, X>::Zero();
+  for (std::size_t i = 0; i < particles_.size(); ++i) cov += w[i] * (d[i] - mean_d) * (d[i] - mean_d).transpose();
+  return {Space::plus(reference, mean_d), symmetrized(cov)};
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::landmark(LandmarkId id) const -> LandmarkEstimate<M> {
+  const auto it = index_.find(id);
+  if (it == index_.end()) throw unknown_landmark_error("unknown landmark id " + std::to_string(id));
+  if (options_.map_estimate == FastSlamMap::best_particle) {
+    const auto& L = particles_[best_particle()].landmarks[it->second];
+    return {id, L.mean, L.cov};
+  }
+  const auto w = weights();
+  Eigen::Matrix<double, M, 1> mean = Eigen::Matrix<double, M, 1>::Zero();
+  for (std::size_t i = 0; i < particles_.size(); ++i) mean += w[i] * particles_[i].landmarks[it->second].mean;
+  Eigen::Matrix<double, M, M> cov = Eigen::Matrix<double, M, M>::Zero();
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    const auto& L = particles_[i].landmarks[it->second];
+    cov += w[i] * (L.cov + (L.mean - mean) * (L.mean - mean).transpose());
+  }
+  return {id, mean, symmetrized(cov)};
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::map() const -> MapEstimate {
+  MapEstimate out;
+  for (LandmarkId id : landmark_ids()) out.push_back(landmark(id));
+  return out;
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+std::vector<LandmarkId> FastSlam<Motion, Sensor, Map>::landmark_ids() const {
+  std::vector<LandmarkId> out;
+  for (LandmarkId id : id_of_index_)
+    if (index_.contains(id)) out.push_back(id);
+  return out;
+}
+
+/// Forgets a landmark in every particle (its index is not reused).
+template <class Motion, class Sensor, template <class> class Map>
+void FastSlam<Motion, Sensor, Map>::remove_landmark(LandmarkId id) {
+  const auto it = index_.find(id);
+  if (it == index_.end()) throw unknown_landmark_error("unknown landmark id " + std::to_string(id));
+  for (auto& particle : particles_) particle.landmarks.mutate(it->second).alive = false;
+  index_.erase(it);
+}
+
+}  // namespace sextant

@@ -1,0 +1,140 @@
+#pragma once
+/// \file FastSLAM 1.0 and 2.0 (thesis §3.7; Montemerlo et al.), a Rao-Blackwellized particle filter,
+/// for any motion and measurement model pair.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <random>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+#include "sextant/core/concepts.hpp"
+#include "sextant/core/gaussian.hpp"
+#include "sextant/core/persistent_array.hpp"
+#include "sextant/core/update_result.hpp"
+
+namespace sextant {
+
+enum class FastSlamVersion {
+  v1,  ///< sample the pose from the motion model (eq. 74); weight by the measurement likelihood (eqs. 79-81)
+  v2,  ///< sample from a proposal that folds in the measurements (eqs. 82-92); weight by eq. 93
+};
+
+/// Where map() takes its landmarks from.
+enum class FastSlamMap {
+  best_particle,     ///< the particle with the largest weight
+  weighted_average,  ///< per landmark, the moment-matched mixture over all particles
+};
+
+struct FastSlamOptions {
+  std::size_t particles = 50;
+  FastSlamVersion version = FastSlamVersion::v2;
+  double resample_threshold = 0.5;  ///< resample when N_eff < threshold * particles (1 = always, 0 = never)
+  FastSlamMap map_estimate = FastSlamMap::best_particle;
+  std::uint64_t seed = 1;
+  /// Per-particle data association (update_unassociated): a measurement whose smallest normalized
+  /// innovation squared over a particle's landmarks exceeds this starts a new landmark there.
+  /// Default chi2(2 dof) at 0.9999: at 0.99 one re-observation in a hundred would become a duplicate
+  /// (seen on the ship, where a 2-3 sigma compass error happens every few dozen steps).
+  double new_landmark_nis = 18.42;
+};
+
+/// One landmark of one particle: an EKF over its position (eqs. 75-78).
+template <int M>
+struct LandmarkGaussian {
+  Eigen::Matrix<double, M, 1> mean = Eigen::Matrix<double, M, 1>::Zero();
+  Eigen::Matrix<double, M, M> cov = Eigen::Matrix<double, M, M>::Identity();
+  bool alive = true;  ///< false once removed
+};
+
+/// FastSLAM: N particles, each a pose and a map of independent landmark EKFs. `Map` holds a
+/// particle's landmarks: PersistentArray (default) shares them between particles after resampling;
+/// CopiedArray copies them (O(J) per copy), for comparison.
+template <class Motion, class Sensor, template <class> class Map = PersistentArray>
+class FastSlam {
+  static_assert(MotionModel<Motion>,
+                "FastSlam<Motion, Sensor>: Motion must satisfy sextant::MotionModel (types State, Control, Space, "
+                "constant kDim, and predict(x, u, dt) returning MotionPrediction<State, kDim>)");
+  static_assert(MeasurementModelFor<Sensor, Motion>,
+                "FastSlam<Motion, Sensor>: Sensor must satisfy sextant::MeasurementModelFor<Sensor, Motion> (fixed-size "
+                "Eigen Landmark and Measurement, predict(x, m) -> MeasurementPrediction, residual(z, z_hat), "
+                "initialize(x, z) -> LandmarkInit)");
+
+ public:
+  using State = typename Motion::State;
+  using Control = typename Motion::Control;
+  using Space = typename Motion::Space;
+  using Landmark = typename Sensor::Landmark;
+  using Measurement = typename Sensor::Measurement;
+  using ObservationType = Observation<Measurement>;
+  static constexpr int X = Motion::kDim;
+  static constexpr int M = landmark_dim_v<Sensor>;
+  static constexpr int Z = measurement_dim_v<Sensor>;
+  using PoseEstimate = Gaussian<State, X>;
+  using MapEstimate = std::vector<LandmarkEstimate<M>>;
+
+  struct Particle {
+    State x;
+    Map<LandmarkGaussian<M>> landmarks;  ///< indexed by the filter's landmark index (known ids)
+    Map<LandmarkGaussian<M>> unassociated;  ///< landmarks this particle found by its own association
+    double log_weight = 0.0;
+  };
+
+  FastSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, FastSlamOptions options = {});
+
+  /// FastSLAM 1.0 samples every particle's pose here; 2.0 only predicts the mean and samples in
+  /// update(), where the measurements shape the proposal.
+  void predict(const Control& u, double dt);
+  /// Observations with known landmark ids; new ids are added to every particle.
+  UpdateResult update(std::span<const ObservationType> observations);
+  UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }
+  /// Measurements without ids: each particle associates them to its own landmarks by maximum
+  /// likelihood, or starts new ones (thesis §7.2).
+  UpdateResult update_unassociated(std::span<const Measurement> measurements);
+
+  void remove_landmark(LandmarkId id);
+
+  /// Weighted mean and covariance of the particle cloud (tangent space around the best particle).
+  PoseEstimate pose() const;
+  MapEstimate map() const;
+  LandmarkEstimate<M> landmark(LandmarkId id) const;
+  bool has_landmark(LandmarkId id) const { return index_.contains(id); }
+  std::size_t num_landmarks() const { return index_.size(); }
+  std::vector<LandmarkId> landmark_ids() const;
+  const std::vector<Particle>& particles() const { return particles_; }
+  /// Normalized weights of the particles.
+  std::vector<double> weights() const;
+  /// Effective sample size 1 / sum w^2 of the normalized weights.
+  double effective_sample_size() const;
+  std::size_t resamplings() const { return resamplings_; }
+  const FastSlamOptions& options() const { return options_; }
+
+ private:
+  struct PendingMotion {
+    Control u;
+    double dt;
+  };
+
+  State sample(const State& mean, const Eigen::Matrix<double, X, X>& cov);
+  void apply_pending_motion_v1();
+  double update_landmark(Particle& particle, std::size_t index, const Measurement& z, bool unassociated);
+  void sample_v2_proposal(Particle& particle, const State& predicted, const Eigen::Matrix<double, X, X>& R,
+                          std::span<const ObservationType> known);
+  void normalize_and_resample();
+  std::size_t best_particle() const;
+
+  Motion motion_;
+  Sensor sensor_;
+  FastSlamOptions options_;
+  std::vector<Particle> particles_;
+  std::unordered_map<LandmarkId, std::size_t> index_;  ///< id -> index in every particle's map
+  std::vector<LandmarkId> id_of_index_;
+  std::vector<PendingMotion> pending_;  ///< v2: motion not yet sampled
+  std::mt19937_64 rng_;
+  std::size_t resamplings_ = 0;
+};
+
+}  // namespace sextant
+
+#include "sextant/backends/detail/fast_slam_impl.hpp"

@@ -1,0 +1,131 @@
+#include "sextant/backends/fast_slam.hpp"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "sextant/eval/runner.hpp"
+#include "sextant/models/beacon_ship_2d.hpp"
+#include "sextant/sim/ship_2d.hpp"
+#include "support/batch_least_squares.hpp"
+
+namespace sextant {
+namespace {
+
+using Fast = FastSlam<BeaconShip2D, BeaconOffset2D>;
+static_assert(SlamBackend<Fast>);
+
+class FastVersions : public ::testing::TestWithParam<FastSlamVersion> {};
+
+TEST_P(FastVersions, OneParticleWithoutMotionNoiseEqualsPerLandmarkKalmanFiltersWithKnownPoses) {
+  const BeaconShip2D motion{0.0, 0.0, HeadingNoise::linearized};  // R = 0: the pose is known exactly
+  const BeaconOffset2D sensor{0.5};
+  const auto steps = test::random_linear_steps(40, 5, 21);
+  Fast fast{motion, sensor, {Eigen::Vector2d(1.0, 2.0), 1e-12 * Eigen::Matrix2d::Identity()},
+            {.particles = 1, .version = GetParam()}};
+  std::map<LandmarkId, std::pair<Eigen::Vector2d, Eigen::Matrix2d>> reference;
+  const Eigen::Matrix2d Q = sensor.noise();
+  for (const auto& step : steps) {
+    fast.predict(step.control, step.dt);
+    fast.update(step.observations);
+    const Eigen::Vector2d x = fast.particles()[0].x;
+    for (const auto& obs : step.observations) {
+      auto it = reference.find(obs.landmark_id);
+      if (it == reference.end()) {
+        reference[obs.landmark_id] = {x + obs.z, Q};
+        continue;
+      }
+      auto& [m, P] = it->second;
+      const Eigen::Matrix2d K = P * (P + Q).inverse();  // 2x2 reference filter
+      m += K * (obs.z - (m - x));
+      P = (Eigen::Matrix2d::Identity() - K) * P;
+    }
+  }
+  for (const auto& [id, expected] : reference) {
+    const auto estimate = fast.landmark(id);
+    EXPECT_LT((estimate.mean - expected.first).cwiseAbs().maxCoeff(), 1e-9) << id;
+    EXPECT_LT((estimate.cov - expected.second).cwiseAbs().maxCoeff(), 1e-9) << id;
+  }
+}
+
+TEST_P(FastVersions, AfterResamplingEachParticlesUpdateDependsOnlyOnItsOwnMap) {
+  const auto data = sim::simulate_ship_2d({.seed = 3, .num_steps = 60});
+  Fast fast{data.motion, data.sensor, data.prior, {.particles = 30, .version = GetParam(), .resample_threshold = 1.0}};
+  eval::run(fast, data.steps);
+  ASSERT_GT(fast.resamplings(), 0u);
+  // Duplicated particles share their maps now. One more update without motion: every particle's
+  // landmark must move by its own Kalman update, not twice through a shared copy.
+  const auto before = fast.particles();
+  const LandmarkId id = data.steps.back().observations.front().landmark_id;
+  const Eigen::Vector2d z = data.steps.back().observations.front().z + Eigen::Vector2d(0.7, -0.4);
+  Fast::ObservationType observation{id, z};
+  Fast copy = fast;
+  copy.update(std::vector<Fast::ObservationType>{observation});
+  // The update resampled again (threshold 1), so compare without ancestry: every particle after
+  // the update must hold exactly the Kalman update of one particle before it (same pose, same slot).
+  const Eigen::Matrix2d Q = data.sensor.noise();
+  std::size_t matched = 0;
+  for (const auto& after : copy.particles()) {
+    bool found = false;
+    for (const auto& p : before) {
+      for (std::size_t j = 0; j < p.landmarks.size() && !found; ++j) {  // the observed slot, whichever it is
+        const auto& L = p.landmarks[j];
+        const Eigen::Matrix2d K = L.cov * (L.cov + Q).inverse();
+        const Eigen::Vector2d m = L.mean + K * (z - (L.mean - p.x));
+        if (p.x == after.x && (after.landmarks[j].mean - m).norm() < 1e-9) found = true;
+      }
+    }
+    matched += found;
+  }
+  EXPECT_EQ(matched, copy.particles().size());
+  // And the filter we copied from is untouched by the copy's update.
+  for (std::size_t i = 0; i < before.size(); ++i)
+    for (std::size_t j = 0; j < before[i].landmarks.size(); ++j)
+      EXPECT_EQ(fast.particles()[i].landmarks[j].mean, before[i].landmarks[j].mean);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothVersions, FastVersions, ::testing::Values(FastSlamVersion::v1, FastSlamVersion::v2));
+
+TEST(FastSlam, TracksTheShipAndVersionTwoBeatsVersionOne) {
+  double mae[2] = {0.0, 0.0};
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    const auto data = sim::simulate_ship_2d({.seed = seed});
+    for (int v = 0; v < 2; ++v) {
+      Fast fast{data.motion, data.sensor, data.prior,
+                {.particles = 20, .version = v ? FastSlamVersion::v2 : FastSlamVersion::v1, .seed = seed}};
+      const auto record = eval::run(fast, data.steps);
+      for (std::size_t k = 0; k < record.steps.size(); ++k)
+        mae[v] += (record.steps[k].pose.mean - data.true_poses[k + 1]).norm() / (3.0 * record.steps.size());
+    }
+  }
+  std::printf("pose MAE with 20 particles: FastSLAM 1.0 %.2f km, 2.0 %.2f km\n", mae[0], mae[1]);
+  EXPECT_LT(mae[1], mae[0]);
+  EXPECT_LT(mae[1], 40.0);
+}
+
+TEST(FastSlam, PerParticleDataAssociationBuildsTheMap) {
+  const auto data = sim::simulate_ship_2d({.seed = 2, .num_steps = 200, .sigma_beacon = 0.5});
+  Fast fast{data.motion, data.sensor, data.prior, {.particles = 20}};
+  for (const auto& step : data.steps) {
+    fast.predict(step.control, step.dt);
+    std::vector<Eigen::Vector2d> z;
+    for (const auto& obs : step.observations) z.push_back(obs.z);
+    fast.update_unassociated(std::span<const Eigen::Vector2d>(z));
+  }
+  std::set<LandmarkId> seen;
+  for (const auto& step : data.steps)
+    for (const auto& obs : step.observations) seen.insert(obs.landmark_id);
+  const auto& best = *std::max_element(fast.particles().begin(), fast.particles().end(),
+                                       [](const auto& a, const auto& b) { return a.log_weight < b.log_weight; });
+  EXPECT_EQ(best.unassociated.size(), seen.size());  // one landmark per beacon, no duplicates
+  EXPECT_LT((fast.pose().mean - data.true_poses.back()).norm(), 20.0);
+}
+
+TEST(FastSlam, RejectsBadOptions) {
+  const Gaussian<Eigen::Vector2d, 2> prior{Eigen::Vector2d::Zero(), Eigen::Matrix2d::Identity()};
+  EXPECT_THROW((Fast{BeaconShip2D{}, BeaconOffset2D{}, prior, {.particles = 0}}), invalid_input_error);
+  EXPECT_THROW((Fast{BeaconShip2D{}, BeaconOffset2D{}, prior, {.resample_threshold = 2.0}}), invalid_input_error);
+}
+
+}  // namespace
+}  // namespace sextant
