@@ -14,6 +14,7 @@ using namespace sextant;
 using ShipEkf = EkfSlam<BeaconShip2D, BeaconOffset2D>;
 using ShipSeif = SeifSlam<BeaconShip2D, BeaconOffset2D>;
 using ShipGraph = GraphSlam<BeaconShip2D, BeaconOffset2D>;
+using ShipFast = FastSlam<BeaconShip2D, BeaconOffset2D>;
 
 using RunSummary = eval::RunSummary<Eigen::Vector2d>;
 
@@ -37,19 +38,21 @@ struct Row {
 };
 
 void print_table(const std::vector<Row>& rows) {
-  std::printf("\n%-24s %13s %12s %13s %16s %15s %11s %14s %s\n", "back-end", "pose MAE[km]", "map MAE[km]",
+  std::printf("\n%-27s %13s %12s %13s %16s %15s %11s %14s %s\n", "back-end", "pose MAE[km]", "map MAE[km]",
               "over time[km]", "pose NEES<=5.99", "map NEES<=5.99", "total [s]", "per step [us]", "pose ANEES [95% int.]");
   for (const auto& [name, s] : rows) {
-    std::printf("%-24s %13.3f %12.3f %13.3f %15.1f%% %14.1f%% %11.5f %14.2f %.3f", name.c_str(), s.pose_mae, s.map_mae,
+    std::printf("%-27s %13.3f %12.3f %13.3f %15.1f%% %14.1f%% %11.5f %14.2f %.4g", name.c_str(), s.pose_mae, s.map_mae,
                 s.map_mae_over_time, 100.0 * s.pose_nees_inside, 100.0 * s.map_nees_inside, s.total_seconds,
                 1e6 * s.seconds_per_step, s.pose_anees);
     if (s.anees_interval) std::printf(" [%.3f, %.3f]", s.anees_interval->lower, s.anees_interval->upper);
     std::printf("\n");
   }
-  std::printf("%-24s %13.2f %12s %13.3f %16s %15s %11.3f %14s\n", "EKF, thesis (MATLAB)", 19.13, "-", 8.590, "-", "-",
+  std::printf("%-27s %13.2f %12s %13.3f %16s %15s %11.3f %14s\n", "EKF, thesis (MATLAB)", 19.13, "-", 8.590, "-", "-",
               1.605, "-");
-  std::printf("%-24s %13.2f %12s %13.3f %16s %15s %11.3f %14s\n", "Graph, thesis (MATLAB)", 9.91, "-", 7.922, "-", "-",
+  std::printf("%-27s %13.2f %12s %13.3f %16s %15s %11.3f %14s\n", "Graph, thesis (MATLAB)", 9.91, "-", 7.922, "-", "-",
               3.994, "-");
+  std::printf("%-27s %13.2f %12s %13.3f %16s %15s %11.3f %14s\n", "FastSLAM 2.0/50, thesis", 19.71, "-", 13.857, "-", "-",
+              12.301, "-");
 }
 
 /// Runs `make_backend(data)` on `runs` simulated seeds in parallel and evaluates each run.
@@ -109,6 +112,13 @@ int main(int argc, char** argv) {
     rows.push_back({"SEIF-SLAM, all active", eval::summarize(monte_carlo_summaries(options, runs, seif(0)), 2, 2)});
     const auto graph = [](const sim::Ship2DDataset& data) { return ShipGraph{data.motion, data.sensor, data.prior}; };
     rows.push_back({"GraphSLAM", eval::summarize(monte_carlo_summaries(options, runs, graph), 2, 2)});
+    for (FastSlamVersion version : {FastSlamVersion::v1, FastSlamVersion::v2}) {
+      const auto fast = [version](const sim::Ship2DDataset& data) {
+        return ShipFast{data.motion, data.sensor, data.prior, {.particles = 50, .version = version}};
+      };
+      rows.push_back({version == FastSlamVersion::v1 ? "FastSLAM 1.0, 50 particles" : "FastSLAM 2.0, 50 particles",
+                      eval::summarize(monte_carlo_summaries(options, runs, fast), 2, 2)});
+    }
     const RunSummary& first_run = ekf_runs.front();
     print_table(rows);
     const double ekf_seconds = rows.front().summary.total_seconds;

@@ -28,6 +28,8 @@ TEST(Metrics, AbsoluteErrorNeesMaeRmse) {
   const Eigen::Matrix2d cov = Eigen::Vector2d(4.0, 1.0).asDiagonal();
   EXPECT_DOUBLE_EQ(nees(Eigen::Vector2d(2.0, 1.0), cov), 2.0);
   EXPECT_THROW(nees(Eigen::Vector2d(1.0, 1.0), Eigen::Matrix2d::Zero()), numerical_error);
+  EXPECT_EQ(nees_or_infinity(Eigen::Vector2d(1.0, 1.0), Eigen::Matrix2d::Zero()), std::numeric_limits<double>::infinity());
+  EXPECT_DOUBLE_EQ(nees_or_infinity(Eigen::Vector2d(2.0, 1.0), cov), 2.0);
   const std::vector<double> errors{1.0, 2.0, 2.0, 3.0};
   EXPECT_DOUBLE_EQ(mean(errors), 2.0);
   EXPECT_DOUBLE_EQ(rms(errors), std::sqrt(4.5));

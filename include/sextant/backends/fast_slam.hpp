@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <span>
 #include <unordered_map>
@@ -95,7 +96,9 @@ class FastSlam {
 
   void remove_landmark(LandmarkId id);
 
-  /// Weighted mean and covariance of the particle cloud (tangent space around the best particle).
+  /// Weighted mean and covariance of the particle cloud (tangent space around the best particle),
+  /// taken after the last update and before its resampling, which would duplicate particles and
+  /// shrink the spread; after a predict, the current cloud.
   PoseEstimate pose() const;
   MapEstimate map() const;
   LandmarkEstimate<M> landmark(LandmarkId id) const;
@@ -122,6 +125,7 @@ class FastSlam {
   void sample_v2_proposal(Particle& particle, const State& predicted, const Eigen::Matrix<double, X, X>& R,
                           std::span<const ObservationType> known);
   void normalize_and_resample();
+  PoseEstimate cloud_estimate() const;
   std::size_t best_particle() const;
 
   Motion motion_;
@@ -133,6 +137,7 @@ class FastSlam {
   std::vector<PendingMotion> pending_;  ///< v2: motion not yet sampled
   std::mt19937_64 rng_;
   std::size_t resamplings_ = 0;
+  std::optional<PoseEstimate> estimate_;  ///< the weighted cloud of the last update, before resampling
 };
 
 }  // namespace sextant

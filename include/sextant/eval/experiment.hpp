@@ -49,7 +49,7 @@ RunSummary<typename Backend::State> evaluate_run(Backend& backend, const Dataset
     const auto error = Space::minus(pose.mean, dataset.true_poses[k + 1]);
     const int n = position_dim < 0 ? static_cast<int>(error.size()) : std::min<int>(position_dim, error.size());
     out.pose_error.push_back(error.head(n).norm());
-    out.pose_nees.push_back(nees(error, pose.cov));
+    out.pose_nees.push_back(nees_or_infinity(error, pose.cov));
     out.seconds.push_back(record.steps[k].seconds);
     out.trajectory.push_back(pose.mean);
   }
@@ -84,7 +84,7 @@ RunSummary<typename Backend::State> evaluate_smoothed_run(Backend& backend, cons
     const auto error = Space::minus(trajectory[k].mean, dataset.true_poses[k]);
     const int n = position_dim < 0 ? static_cast<int>(error.size()) : std::min<int>(position_dim, error.size());
     out.pose_error.push_back(error.head(n).norm());
-    out.pose_nees.push_back(nees(error, trajectory[k].cov));
+    out.pose_nees.push_back(nees_or_infinity(error, trajectory[k].cov));
     out.trajectory.push_back(trajectory[k].mean);
   }
   auto map = evaluate_map(backend.map(), dataset.true_landmarks);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <limits>
 #include <numeric>
 #include <span>
 #include <string>
@@ -27,6 +28,16 @@ double absolute_error(const Eigen::MatrixBase<A>& estimate, const Eigen::MatrixB
 template <class E, class C>
 double nees(const Eigen::MatrixBase<E>& error, const Eigen::MatrixBase<C>& cov) {
   return mahalanobis_squared(cholesky_or_throw(cov.eval(), "covariance in NEES"), error);
+}
+
+/// NEES, or +infinity when the covariance is not positive definite (a collapsed estimate, e.g. a
+/// particle cloud of identical particles, is maximally overconfident): for evaluations that must
+/// not stop at one degenerate step.
+template <class E, class C>
+double nees_or_infinity(const Eigen::MatrixBase<E>& error, const Eigen::MatrixBase<C>& cov) {
+  const Eigen::LLT<typename C::PlainObject> llt(cov.eval());
+  if (llt.info() != Eigen::Success || !cov.allFinite()) return std::numeric_limits<double>::infinity();
+  return mahalanobis_squared(llt, error);
 }
 
 /// Mean of the values (MAE when they are absolute errors); 0 for an empty range.
@@ -99,7 +110,7 @@ MapEvaluation evaluate_map(const std::vector<LandmarkEstimate<M>>& map, const st
     const Eigen::Matrix<double, M, 1> error = landmark.mean - it->second;
     out.ids.push_back(landmark.id);
     out.errors.push_back(error.norm());
-    out.nees.push_back(nees(error, landmark.cov));
+    out.nees.push_back(nees_or_infinity(error, landmark.cov));
   }
   return out;
 }

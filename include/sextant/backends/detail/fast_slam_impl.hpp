@@ -53,6 +53,7 @@ void FastSlam<Motion, Sensor, Map>::predict(const Control& u, double dt) {
     const auto p = motion_.predict(particle.x, u, dt);
     if (!Space::is_finite(p.x) || !p.R.allFinite()) throw numerical_error("motion model returned NaN or Inf");
   }
+  estimate_.reset();
   if (options_.version == FastSlamVersion::v2) {
     apply_pending_motion_v1();  // two predicts in a row: the first one is sampled plainly
     pending_.push_back({u, dt});
@@ -241,6 +242,7 @@ void FastSlam<Motion, Sensor, Map>::normalize_and_resample() {
   for (const auto& p : particles_) sum += std::exp(p.log_weight - max_log);
   const double log_total = max_log + std::log(sum);
   for (auto& p : particles_) p.log_weight -= log_total;
+  estimate_ = cloud_estimate();
   const double n = static_cast<double>(particles_.size());
   if (effective_sample_size() >= options_.resample_threshold * n) return;
   const auto w = weights();
@@ -286,6 +288,11 @@ std::size_t FastSlam<Motion, Sensor, Map>::best_particle() const {
 /// not yet sampled by FastSLAM 2.0 counts at its predicted mean).
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::pose() const -> PoseEstimate {
+  return estimate_ ? *estimate_ : cloud_estimate();
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::cloud_estimate() const -> PoseEstimate {
   const auto w = weights();
   auto pose_of = [&](const Particle& p) {
     State x = p.x;
