@@ -38,13 +38,7 @@ struct EkfOptions {
 /// are added with the cross-covariance of the model's inverse.
 template <class Motion, class Sensor>
 class EkfSlam {
-  static_assert(MotionModel<Motion>,
-                "EkfSlam<Motion, Sensor>: Motion must satisfy sextant::MotionModel (types State, Control, Space, "
-                "constant kDim, and predict(x, u, dt) returning MotionPrediction<State, kDim>)");
-  static_assert(MeasurementModelFor<Sensor, Motion>,
-                "EkfSlam<Motion, Sensor>: Sensor must satisfy sextant::MeasurementModelFor<Sensor, Motion> (fixed-size "
-                "Eigen Landmark and Measurement, predict(x, m) -> MeasurementPrediction, residual(z, z_hat), "
-                "initialize(x, z) -> LandmarkInit)");
+  static_assert(ModelsFit<Motion, Sensor>::value, "EkfSlam: the models do not fit (see the message above)");
 
  public:
   using State = typename Motion::State;

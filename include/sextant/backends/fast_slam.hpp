@@ -54,13 +54,7 @@ struct LandmarkGaussian {
 /// CopiedArray copies them (O(J) per copy), for comparison.
 template <class Motion, class Sensor, template <class> class Map = PersistentArray>
 class FastSlam {
-  static_assert(MotionModel<Motion>,
-                "FastSlam<Motion, Sensor>: Motion must satisfy sextant::MotionModel (types State, Control, Space, "
-                "constant kDim, and predict(x, u, dt) returning MotionPrediction<State, kDim>)");
-  static_assert(MeasurementModelFor<Sensor, Motion>,
-                "FastSlam<Motion, Sensor>: Sensor must satisfy sextant::MeasurementModelFor<Sensor, Motion> (fixed-size "
-                "Eigen Landmark and Measurement, predict(x, m) -> MeasurementPrediction, residual(z, z_hat), "
-                "initialize(x, z) -> LandmarkInit)");
+  static_assert(ModelsFit<Motion, Sensor>::value, "FastSlam: the models do not fit (see the message above)");
 
  public:
   using State = typename Motion::State;

@@ -59,13 +59,7 @@ struct OptimizationSummary {
 /// come from a selected inversion of the sparse information matrix.
 template <class Motion, class Sensor>
 class GraphSlam {
-  static_assert(MotionModel<Motion>,
-                "GraphSlam<Motion, Sensor>: Motion must satisfy sextant::MotionModel (types State, Control, Space, "
-                "constant kDim, and predict(x, u, dt) returning MotionPrediction<State, kDim>)");
-  static_assert(MeasurementModelFor<Sensor, Motion>,
-                "GraphSlam<Motion, Sensor>: Sensor must satisfy sextant::MeasurementModelFor<Sensor, Motion> (fixed-size "
-                "Eigen Landmark and Measurement, predict(x, m) -> MeasurementPrediction, residual(z, z_hat), "
-                "initialize(x, z) -> LandmarkInit)");
+  static_assert(ModelsFit<Motion, Sensor>::value, "GraphSlam: the models do not fit (see the message above)");
 
  public:
   using State = typename Motion::State;

@@ -42,13 +42,7 @@ struct SeifOptions {
 /// Covariances are computed on demand by sparse Cholesky solves, never by inverting Omega.
 template <class Motion, class Sensor>
 class SeifSlam {
-  static_assert(MotionModel<Motion>,
-                "SeifSlam<Motion, Sensor>: Motion must satisfy sextant::MotionModel (types State, Control, Space, "
-                "constant kDim, and predict(x, u, dt) returning MotionPrediction<State, kDim>)");
-  static_assert(MeasurementModelFor<Sensor, Motion>,
-                "SeifSlam<Motion, Sensor>: Sensor must satisfy sextant::MeasurementModelFor<Sensor, Motion> (fixed-size "
-                "Eigen Landmark and Measurement, predict(x, m) -> MeasurementPrediction, residual(z, z_hat), "
-                "initialize(x, z) -> LandmarkInit)");
+  static_assert(ModelsFit<Motion, Sensor>::value, "SeifSlam: the models do not fit (see the message above)");
 
  public:
   using State = typename Motion::State;

@@ -56,6 +56,20 @@ concept MeasurementModelFor =
       { sensor.initialize(x, z) } -> std::same_as<LandmarkInit<landmark_dim_v<S>, Motion::kDim, measurement_dim_v<S>>>;
     };
 
+/// Every back-end checks its models with static_assert(ModelsFit<Motion, Sensor>::value): a model
+/// that does not fit fails with one of these messages instead of a template backtrace.
+template <class Motion, class Sensor>
+struct ModelsFit {
+  static_assert(MotionModel<Motion>,
+                "sextant back-end: Motion must satisfy sextant::MotionModel (types State, Control, Space, constant "
+                "kDim, and predict(x, u, dt) returning MotionPrediction<State, kDim>)");
+  static_assert(MeasurementModelFor<Sensor, Motion>,
+                "sextant back-end: Sensor must satisfy sextant::MeasurementModelFor<Sensor, Motion> (fixed-size Eigen "
+                "Landmark and Measurement, predict(x, m) -> MeasurementPrediction, residual(z, z_hat), "
+                "initialize(x, z) -> LandmarkInit)");
+  static constexpr bool value = MotionModel<Motion> && MeasurementModelFor<Sensor, Motion>;
+};
+
 /// The face every back-end shows: predict, update with observations, pose, map, remove_landmark.
 template <class B>
 concept SlamBackend = requires(B& backend, const B& const_backend, const typename B::Control& u, double dt,
