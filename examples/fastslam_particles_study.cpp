@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
     std::printf("| version | particles | pose MAE [km] | map MAE [km] | pose ANEES [95%% interval] | pose NEES <= 5.991 "
                 "| per step [us] | thesis 2.0 pose / map MAE |\n|---|---|---|---|---|---|---|---|\n");
     for (FastSlamVersion version : {FastSlamVersion::v1, FastSlamVersion::v2}) {
-      for (std::size_t particles : {5u, 10u, 20u, 50u, 100u}) {
+      for (std::size_t particles : {5u, 10u, 20u, 50u, 100u, 300u, 1000u}) {
         const auto results = eval::monte_carlo(runs, options.seed, [&](std::uint64_t seed) {
           sim::Ship2DOptions o = options;
           o.seed = seed;
@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
           return eval::evaluate_run(fast, data);
         });
         const auto s = eval::summarize(results, 2, 2);
-        std::printf("| %s | %zu | %.2f ± %.2f | %.2f ± %.2f | %.2f [%.2f, %.2f] | %.1f%% | %.1f | ",
+        std::printf("| %s | %zu | %.2f ± %.2f | %.2f ± %.2f | %.3g [%.2f, %.2f] | %.1f%% | %.1f | ",
                     version == FastSlamVersion::v1 ? "1.0" : "2.0", particles, s.pose_mae, s.pose_mae_std, s.map_mae,
                     s.map_mae_std, s.pose_anees, s.anees_interval->lower, s.anees_interval->upper,
                     100.0 * s.pose_nees_inside, 1e6 * s.seconds_per_step);
