@@ -39,7 +39,7 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   const auto singular_values = Eigen::JacobiSVD<MatrixX>(prediction.J_x_x).singularValues();
   if (!(singular_values(X - 1) > 1e-12 * singular_values(0)))
     throw numerical_error("motion Jacobian G is singular; the SEIF motion update needs G^-1");
-  const MatrixX G_inv_T = prediction.J_x_x.partialPivLu().inverse().transpose();  // X x X, conditioning checked above
+  const MatrixX G_inv_T = prediction.J_x_x.partialPivLu().solve(MatrixX::Identity()).transpose();  // conditioning checked above
   const MatrixX Phi_xx = symmetrized(G_inv_T * info_.robot() * G_inv_T.transpose());
   const MatrixX T = symmetrized(
       (MatrixX::Identity() + prediction.R * Phi_xx).partialPivLu().solve(prediction.R));
