@@ -14,9 +14,9 @@ namespace {
 using Ekf = EkfSlam<BeaconShip2D, BeaconOffset2D>;
 static_assert(SlamBackend<Ekf>);
 
-const BeaconShip2D kMotion{0.3, 0.2, HeadingNoise::linearized};
-const BeaconOffset2D kSensor{0.5};
-const Gaussian<Eigen::Vector2d, 2> kPrior{Eigen::Vector2d(1.0, -2.0), 0.04 * Eigen::Matrix2d::Identity()};
+const auto& kMotion = test::kLinearMotion;
+const auto& kSensor = test::kLinearSensor;
+const auto& kPrior = test::kLinearPrior;
 
 Ekf run_filter(const std::vector<Step<Eigen::Vector2d, Eigen::Vector2d>>& steps, EkfOptions options) {
   Ekf ekf{kMotion, kSensor, kPrior, options};

@@ -16,9 +16,9 @@ namespace {
 using Graph = GraphSlam<BeaconShip2D, BeaconOffset2D>;
 static_assert(SlamBackend<Graph>);
 
-const BeaconShip2D kMotion{0.3, 0.2, HeadingNoise::linearized};
-const BeaconOffset2D kSensor{0.5};
-const Gaussian<Eigen::Vector2d, 2> kPrior{Eigen::Vector2d(1.0, -2.0), 0.04 * Eigen::Matrix2d::Identity()};
+const auto& kMotion = test::kLinearMotion;
+const auto& kSensor = test::kLinearSensor;
+const auto& kPrior = test::kLinearPrior;
 
 class GraphLinear : public ::testing::TestWithParam<GraphSolver> {};
 

@@ -50,9 +50,9 @@ TEST(SeifSlam, WithoutSparsificationEqualsEkfOverTheWholeShipRun) {
 }
 
 TEST(SeifSlam, LinearGaussianProblemEqualsExactBatchLeastSquares) {
-  const BeaconShip2D motion{0.3, 0.2, HeadingNoise::linearized};
-  const BeaconOffset2D sensor{0.5};
-  const Gaussian<Eigen::Vector2d, 2> prior{Eigen::Vector2d(1.0, -2.0), 0.04 * Eigen::Matrix2d::Identity()};
+  const auto& motion = test::kLinearMotion;
+  const auto& sensor = test::kLinearSensor;
+  const auto& prior = test::kLinearPrior;
   const auto steps = test::random_linear_steps(60, 6, 7);
   const auto batch = test::solve_linear_ship_problem(motion, sensor, prior, steps);
   Seif seif{motion, sensor, prior, {.max_active = 0, .mean_recovery_sweeps = 1}};

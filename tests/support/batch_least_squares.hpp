@@ -10,6 +10,11 @@
 
 namespace sextant::test {
 
+/// The models and prior of the small linear test problem (random_linear_steps below).
+inline const BeaconShip2D kLinearMotion{0.3, 0.2, HeadingNoise::linearized};
+inline const BeaconOffset2D kLinearSensor{0.5};
+inline const Gaussian<Eigen::Vector2d, 2> kLinearPrior{Eigen::Vector2d(1.0, -2.0), 0.04 * Eigen::Matrix2d::Identity()};
+
 struct BatchSolution {
   Eigen::VectorXd mean;        // [x_0 .. x_K, landmarks in id order]
   Eigen::MatrixXd covariance;  // inverse of the information matrix

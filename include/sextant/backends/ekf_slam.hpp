@@ -90,8 +90,7 @@ class EkfSlam {
   struct Correction {
     Eigen::VectorXd delta;
     Eigen::MatrixXd C;        ///< P H^T (n x Zk)
-    Eigen::MatrixXd S;        ///< innovation covariance
-    Eigen::MatrixXd L;        ///< lower Cholesky factor of S
+    Eigen::MatrixXd L;        ///< lower Cholesky factor of the innovation covariance S
   };
 
   static Eigen::Index offset_of(std::size_t slot) { return X + M * static_cast<Eigen::Index>(slot); }

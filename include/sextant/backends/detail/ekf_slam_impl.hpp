@@ -112,15 +112,14 @@ auto EkfSlam<Motion, Sensor>::compute_correction(const std::vector<Linearized>& 
     out.C.template middleCols<Z>(Z * i) = cross_covariance(observations[i]);
     nu.template segment<Z>(Z * i) = observations[i].residual;
   }
-  out.S.resize(Z * k, Z * k);
+  Eigen::MatrixXd S(Z * k, Z * k);
   for (Eigen::Index i = 0; i < k; ++i) {
     const auto& obs = observations[i];
-    out.S.template middleRows<Z>(Z * i) =
+    S.template middleRows<Z>(Z * i) =
         obs.J_z_x * out.C.template topRows<X>() + obs.J_z_m * out.C.template middleRows<M>(obs.offset);
-    out.S.template block<Z, Z>(Z * i, Z * i) += obs.Q;
+    S.template block<Z, Z>(Z * i, Z * i) += obs.Q;
   }
-  out.S = symmetrized(out.S);
-  const auto llt = cholesky_or_throw(out.S, "innovation covariance S");
+  const auto llt = cholesky_or_throw(symmetrized(S), "innovation covariance S");
   out.L = llt.matrixL();
   out.delta = out.C * llt.solve(nu);
   if (!out.delta.allFinite()) throw numerical_error("EKF correction is not finite");
