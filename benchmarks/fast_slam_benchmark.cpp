@@ -3,41 +3,19 @@
 // plain per-particle vectors (every resample copies O(J) landmarks per particle). Heap per particle
 // measured with glibc's mallinfo2 around the construction.
 #include <benchmark/benchmark.h>
-#include <malloc.h>
 
 #include <cmath>
 #include <numbers>
 #include <sextant/sextant.hpp>
 
+#include "circle_world.hpp"
+
 namespace {
 
 using namespace sextant;
-using Obs = Observation<Eigen::Vector2d>;
+using bench::CircleWorld;
+using bench::heap_in_use;
 constexpr std::size_t kParticles = 100;
-
-/// Beacons on a circle one unit apart; the ship sails a circle inside, seeing the 4 nearest.
-struct CircleWorld {
-  explicit CircleWorld(int landmarks) : count(landmarks), radius(landmarks / (2.0 * std::numbers::pi)) {}
-  double angle(int j) const { return 2.0 * std::numbers::pi * (j % count) / count; }
-  Eigen::Vector2d beacon(int j) const { return radius * Eigen::Vector2d(std::cos(angle(j)), std::sin(angle(j))); }
-  Eigen::Vector2d ship(int step) const { return (radius - 3.0) * Eigen::Vector2d(std::cos(angle(step)), std::sin(angle(step))); }
-  Eigen::Vector2d control(int step) const {
-    const Eigen::Vector2d d = ship(step) - ship(step - 1);
-    return {d.norm(), std::atan2(d.y(), d.x())};
-  }
-  std::vector<Obs> observations(int step) const {
-    std::vector<Obs> out;
-    for (int i = 0; i < 4; ++i) out.push_back({static_cast<LandmarkId>((step + i) % count), beacon(step + i) - ship(step)});
-    return out;
-  }
-  int count;
-  double radius;
-};
-
-std::size_t heap_in_use() {
-  const auto info = mallinfo2();
-  return info.uordblks + info.hblkhd;
-}
 
 template <template <class> class Map>
 void run(benchmark::State& state) {
@@ -47,9 +25,7 @@ void run(benchmark::State& state) {
   Filter fast{BeaconShip2D{0.05, 0.01, HeadingNoise::linearized}, BeaconOffset2D{0.1},
               {world.ship(0), 0.01 * Eigen::Matrix2d::Identity()},
               {.particles = kParticles, .version = FastSlamVersion::v2, .resample_threshold = 1.0}};
-  std::vector<Obs> all;  // map every beacon first
-  for (int j = 0; j < world.count; ++j) all.push_back({static_cast<LandmarkId>(j), world.beacon(j) - world.ship(0)});
-  fast.update(all);
+  fast.update(world.all_beacons());  // map every beacon first
   const double bytes = static_cast<double>(heap_in_use() - heap_before);
   int step = 0;
   for (auto _ : state) {
