@@ -1,0 +1,92 @@
+#pragma once
+/// \file Readers for the ground-truth files that come with MRPT's kf-slam demo data sets
+/// (/usr/share/mrpt/datasets, Debian mrpt-common): the landmark map, one landmark per row
+/// `x y z ... id` (the id in the last column), and the robot path, one pose per row
+/// `x y z yaw pitch roll`. Lines starting with '%' or '#' are comments. Plain text: no MRPT needed.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "sextant/core/error.hpp"
+#include "sextant/core/observation.hpp"
+
+namespace sextant::io {
+
+namespace detail {
+
+/// The numeric rows of a whitespace-separated text file, each with its line number; throws
+/// parse_error naming file:line for a token that is not a finite number.
+inline std::vector<std::pair<int, std::vector<double>>> read_numeric_rows(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw parse_error(path + ": cannot open file");
+  std::vector<std::pair<int, std::vector<double>>> rows;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '%' || line[first] == '#') continue;
+    std::istringstream fields(line);
+    std::vector<double> values;
+    std::string token;
+    while (fields >> token) {
+      std::size_t used = 0;
+      double value = 0.0;
+      try {
+        value = std::stod(token, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != token.size() || !std::isfinite(value))
+        throw parse_error(path + ":" + std::to_string(number) + ": '" + token + "' is not a finite number");
+      values.push_back(value);
+    }
+    rows.emplace_back(number, std::move(values));
+  }
+  return rows;
+}
+
+}  // namespace detail
+
+/// Landmark positions by id, the first D coordinates of each row (D = 2 or 3).
+template <int D>
+std::map<LandmarkId, Eigen::Matrix<double, D, 1>> read_kf_slam_landmarks(const std::string& path) {
+  static_assert(D == 2 || D == 3);
+  std::map<LandmarkId, Eigen::Matrix<double, D, 1>> out;
+  for (const auto& [line, values] : detail::read_numeric_rows(path)) {
+    const std::string where = path + ":" + std::to_string(line);
+    if (values.size() < 4) throw parse_error(where + ": expected 'x y z ... id', got " + std::to_string(values.size()) + " values");
+    const double id = values.back();
+    if (id < 0 || id != std::floor(id)) throw parse_error(where + ": landmark id must be a non-negative integer");
+    if (!out.emplace(static_cast<LandmarkId>(id), Eigen::Matrix<double, D, 1>(values.data())).second)
+      throw parse_error(where + ": landmark " + std::to_string(static_cast<LandmarkId>(id)) + " appears twice");
+  }
+  if (out.empty()) throw parse_error(path + ": no landmarks");
+  return out;
+}
+
+/// Robot path rows (x, y, z, yaw, pitch, roll).
+inline std::vector<Eigen::Matrix<double, 6, 1>> read_kf_slam_path(const std::string& path) {
+  std::vector<Eigen::Matrix<double, 6, 1>> out;
+  for (const auto& [line, values] : detail::read_numeric_rows(path)) {
+    if (values.size() != 6)
+      throw parse_error(path + ":" + std::to_string(line) + ": expected 6 values (x y z yaw pitch roll), got " +
+                        std::to_string(values.size()));
+    out.emplace_back(values.data());
+  }
+  if (out.empty()) throw parse_error(path + ": no poses");
+  return out;
+}
+
+/// The planar part (x, y, yaw) of each pose of a path.
+inline std::vector<Eigen::Vector3d> planar_path(const std::vector<Eigen::Matrix<double, 6, 1>>& path) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(path.size());
+  for (const auto& p : path) out.emplace_back(p(0), p(1), p(3));
+  return out;
+}
+
+}  // namespace sextant::io

@@ -1,0 +1,78 @@
+#pragma once
+/// \file Range, yaw and pitch to a 3D point landmark from a sensor mounted on a 6D robot (MRPT's
+/// CObservationBearingRange): with l = the landmark in the sensor frame, z = (|l|, atan2(l_y, l_x),
+/// -atan2(l_z, |l_xy|)) (pitch is minus the elevation, as CPose3D::sphericalCoordinates gives it).
+/// Pairs with Se3Odometry. Jacobians by automatic differentiation.
+
+#include <Eigen/Core>
+#include <cmath>
+
+#include "sextant/core/autodiff.hpp"
+#include "sextant/core/model_results.hpp"
+#include "sextant/core/pose3_euler_space.hpp"
+
+namespace sextant {
+
+struct RangeBearing3D {
+  using Landmark = Eigen::Vector3d;
+  using Measurement = Eigen::Vector3d;  ///< (range, yaw, pitch) in the sensor frame
+
+  Eigen::Matrix<double, 6, 1> sensor_pose = Eigen::Matrix<double, 6, 1>::Zero();  ///< sensor on the robot
+  Eigen::Matrix3d Q = Eigen::Matrix3d::Identity();  ///< covariance of (range, yaw, pitch)
+
+  MeasurementPrediction<3, 6, 3> predict(const Eigen::Matrix<double, 6, 1>& x, const Landmark& m) const {
+    Eigen::Matrix<double, 9, 1> arguments;
+    arguments << x, m;
+    const auto f = value_and_jacobian<3>(
+        [this](const auto& a) {
+          using Scalar = typename std::decay_t<decltype(a)>::Scalar;
+          const Pose3Euler<Scalar> sensor = compose<Scalar>(a.template head<6>(), sensor_pose.cast<Scalar>());
+          return spherical<Scalar>(point_in_frame<Scalar>(sensor, a.template tail<3>()));
+        },
+        arguments);
+    MeasurementPrediction<3, 6, 3> out;
+    out.z = f.value;
+    out.J_z_x = f.jacobian.leftCols<6>();
+    out.J_z_m = f.jacobian.rightCols<3>();
+    out.Q = Q;
+    return out;
+  }
+
+  Measurement residual(const Measurement& z, const Measurement& z_hat) const {
+    return {z(0) - z_hat(0), wrap_angle_generic(z(1) - z_hat(1)), wrap_angle_generic(z(2) - z_hat(2))};
+  }
+
+  /// m = sensor (+) (r cos(p) cos(y), r cos(p) sin(y), -r sin(p)).
+  LandmarkInit<3, 6, 3> initialize(const Eigen::Matrix<double, 6, 1>& x, const Measurement& z) const {
+    Eigen::Matrix<double, 9, 1> arguments;
+    arguments << x, z;
+    const auto f = value_and_jacobian<3>(
+        [this](const auto& a) {
+          using Scalar = typename std::decay_t<decltype(a)>::Scalar;
+          using std::cos;
+          using std::sin;
+          const Pose3Euler<Scalar> sensor = compose<Scalar>(a.template head<6>(), sensor_pose.cast<Scalar>());
+          const Scalar r = a(6), yaw = a(7), pitch = a(8);
+          const Eigen::Matrix<Scalar, 3, 1> local(r * cos(pitch) * cos(yaw), r * cos(pitch) * sin(yaw), -r * sin(pitch));
+          return Eigen::Matrix<Scalar, 3, 1>(sensor.template head<3>() + rotation_of(sensor) * local);
+        },
+        arguments);
+    LandmarkInit<3, 6, 3> out;
+    out.m = f.value;
+    out.J_m_x = f.jacobian.leftCols<6>();
+    out.J_m_z = f.jacobian.rightCols<3>();
+    out.Q = Q;
+    return out;
+  }
+
+  /// (range, yaw, pitch) of a point in the sensor frame.
+  template <class Scalar>
+  static Eigen::Matrix<Scalar, 3, 1> spherical(const Eigen::Matrix<Scalar, 3, 1>& l) {
+    using std::atan2;
+    using std::sqrt;
+    const Scalar horizontal = sqrt(l(0) * l(0) + l(1) * l(1));
+    return {sqrt(horizontal * horizontal + l(2) * l(2)), atan2(l(1), l(0)), Scalar(-atan2(l(2), horizontal))};
+  }
+};
+
+}  // namespace sextant
