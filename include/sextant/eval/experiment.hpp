@@ -13,6 +13,11 @@
 
 namespace sextant::eval {
 
+/// A per-step callback that does nothing.
+struct NoStepCallback {
+  void operator()(std::size_t) const {}
+};
+
 /// Accuracy, consistency and time of one run.
 template <class State>
 struct RunSummary {
@@ -30,14 +35,17 @@ struct RunSummary {
 
 /// Runs `backend` over dataset.steps and scores it against dataset.true_poses (row k + 1 is the
 /// pose after step k) and dataset.true_landmarks. The position error is the norm of the first
-/// `position_dim` entries of minus(estimate, truth) (default: all of them).
-template <class Backend, class Dataset>
-RunSummary<typename Backend::State> evaluate_run(Backend& backend, const Dataset& dataset, int position_dim = -1) {
+/// `position_dim` entries of minus(estimate, truth) (default: all of them). on_step(k) is called
+/// after step k (progress reports).
+template <class Backend, class Dataset, class OnStep = NoStepCallback>
+RunSummary<typename Backend::State> evaluate_run(Backend& backend, const Dataset& dataset, int position_dim = -1,
+                                                 OnStep on_step = {}) {
   using Space = typename Backend::Space;
   RunSummary<typename Backend::State> out;
   double map_error_sum = 0.0;
   std::size_t steps_with_map = 0;
-  const auto record = run(backend, dataset.steps, [&](std::size_t, const Backend& b) {
+  const auto record = run(backend, dataset.steps, [&](std::size_t k, const Backend& b) {
+    on_step(k);
     const auto map = b.map();
     if (map.empty()) return;
     map_error_sum += mean(evaluate_map(map, dataset.true_landmarks).errors);
@@ -63,9 +71,10 @@ RunSummary<typename Backend::State> evaluate_run(Backend& backend, const Dataset
 /// Full SLAM (a back-end with optimize() and trajectory()): records every step, optimizes once,
 /// then scores the optimized trajectory and map. `seconds` holds the recording time of each step;
 /// total_seconds adds the optimization.
-template <class Backend, class Dataset>
+template <class Backend, class Dataset, class OnStep = NoStepCallback>
   requires requires(Backend& b) { b.optimize(); b.trajectory(); }
-RunSummary<typename Backend::State> evaluate_smoothed_run(Backend& backend, const Dataset& dataset, int position_dim = -1) {
+RunSummary<typename Backend::State> evaluate_smoothed_run(Backend& backend, const Dataset& dataset, int position_dim = -1,
+                                                          OnStep on_step = {}) {
   using Space = typename Backend::Space;
   using Clock = std::chrono::steady_clock;
   RunSummary<typename Backend::State> out;
@@ -75,6 +84,7 @@ RunSummary<typename Backend::State> evaluate_smoothed_run(Backend& backend, cons
     backend.update(step.observations);
     out.seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
     out.total_seconds += out.seconds.back();
+    on_step(out.seconds.size() - 1);
   }
   const auto start = Clock::now();
   backend.optimize();

@@ -1,0 +1,120 @@
+#pragma once
+// What sextant-run writes with --out: per data set and back-end a per-step CSV, the final map as
+// CSV, TUM trajectories (estimate and ground truth), an MRPT .3Dscene; and a summary.json of the
+// whole table.
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <sextant/core/pose3_euler_space.hpp>
+#include <sextant/eval/metrics.hpp>
+#include <sextant/io/csv_writer.hpp>
+#include <sextant/io/tum_writer.hpp>
+#include <sextant/mrpt/scene.hpp>
+#include <string>
+#include <vector>
+
+#include "experiments.hpp"
+
+namespace sextant::runner {
+
+/// A pose or position of any of the runner's state types as a point in 3D.
+template <class State>
+Eigen::Vector3d position_3d(const State& x) {
+  if constexpr (State::RowsAtCompileTime == 6) return x.template head<3>();
+  else return {x(0), x(1), 0.0};
+}
+
+/// A state as a TUM pose: positions (ship), planar poses (x, y, heading), 6D (x y z yaw pitch roll).
+template <class State>
+io::TumPose tum_pose(double timestamp, const State& x) {
+  if constexpr (State::RowsAtCompileTime == 2) return io::tum_pose_from_position(timestamp, x);
+  else if constexpr (State::RowsAtCompileTime == 3) return io::tum_pose_from_se2(timestamp, x(0), x(1), x(2));
+  else return {timestamp, x.template head<3>(), Eigen::Quaterniond(rotation_from_ypr(x(3), x(4), x(5)))};
+}
+
+template <class Dataset>
+void write_steps_csv(const std::string& path, const BackendRun<Dataset>& r, const Scoring& scoring) {
+  std::vector<std::string> header{"step", "x", "y", "z", "pose_error", "pose_nees", "nees_bound_95", "seconds"};
+  io::CsvWriter csv(path, header);
+  const double bound = eval::nees_upper_bound(scoring.pose_dof, 0.95);
+  for (std::size_t k = 0; k < r.run.trajectory.size(); ++k) {
+    const Eigen::Vector3d p = position_3d(r.run.trajectory[k]);
+    csv.row({static_cast<double>(k + 1), p.x(), p.y(), p.z(), r.run.pose_error[k], r.run.pose_nees[k], bound,
+             k < r.run.seconds.size() ? r.run.seconds[k] : 0.0});
+  }
+}
+
+template <class Dataset>
+void write_map_csv(const std::string& path, const BackendRun<Dataset>& r, const Dataset& data) {
+  io::CsvWriter csv(path, {"id", "x", "y", "z", "true_x", "true_y", "true_z", "cov_xx", "cov_xy", "cov_yy"});
+  for (const auto& l : r.map) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero(), truth = Eigen::Vector3d::Zero();
+    mean.head(l.mean.size()) = l.mean;
+    const auto it = data.true_landmarks.find(l.id);
+    if (it != data.true_landmarks.end()) truth.head(it->second.size()) = it->second;
+    csv.row({static_cast<double>(l.id), mean.x(), mean.y(), mean.z(), truth.x(), truth.y(), truth.z(), l.cov(0, 0),
+             l.cov(0, 1), l.cov(1, 1)});
+  }
+}
+
+template <class Dataset>
+mrpt_io::SceneContent scene_content(const BackendRun<Dataset>& r, const Dataset& data) {
+  mrpt_io::SceneContent scene;
+  for (const auto& x : r.run.trajectory) scene.estimated_path.push_back(position_3d(x));
+  for (std::size_t k = 1; k < data.true_poses.size() && k <= r.run.trajectory.size(); ++k)
+    scene.true_path.push_back(position_3d(data.true_poses[k]));
+  scene.landmarks = mrpt_io::scene_landmarks(r.map);
+  for (const auto& [id, m] : data.true_landmarks) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    p.head(m.size()) = m;
+    scene.true_landmarks.push_back(p);
+  }
+  for (const auto& x : r.particles) scene.particles.push_back(position_3d(x));
+  return scene;
+}
+
+/// All files of one back-end on one data set, into `dir`.
+template <class Dataset>
+void write_run_outputs(const std::filesystem::path& dir, BackendKind kind, const BackendRun<Dataset>& r,
+                       const Dataset& data, const Scoring& scoring, const RunnerConfig& c) {
+  std::filesystem::create_directories(dir);
+  const std::string key = backend_key(kind);
+  write_steps_csv((dir / (key + "_steps.csv")).string(), r, scoring);
+  write_map_csv((dir / (key + "_map.csv")).string(), r, data);
+  std::vector<io::TumPose> estimated, truth;
+  for (std::size_t k = 0; k < r.run.trajectory.size(); ++k) {
+    estimated.push_back(tum_pose(static_cast<double>(k + 1), r.run.trajectory[k]));
+    if (k + 1 < data.true_poses.size()) truth.push_back(tum_pose(static_cast<double>(k + 1), data.true_poses[k + 1]));
+  }
+  io::write_tum((dir / (key + "_trajectory.tum")).string(), estimated);
+  io::write_tum((dir / "ground_truth.tum").string(), truth);
+  mrpt_io::write_scene((dir / (key + ".3Dscene")).string(), scene_content(r, data), {.quantile = c.scene_quantile});
+}
+
+/// A JSON number, or null when not finite (JSON has no NaN or Inf).
+inline std::string json_number(double x) {
+  if (!std::isfinite(x)) return "null";
+  std::ostringstream out;
+  out << std::setprecision(10) << x;
+  return out.str();
+}
+
+/// The table as JSON: one object per row.
+inline void write_summary_json(const std::string& path, const std::vector<TableRow>& rows) {
+  std::ofstream out(path);
+  if (!out) throw error("cannot open " + path + " for writing");
+  out << std::setprecision(10) << "[\n";
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& s = rows[i].summary;
+    out << "  {\"dataset\": \"" << rows[i].dataset << "\", \"backend\": \"" << rows[i].backend << "\", \"label\": \""
+        << rows[i].label << "\", \"runs\": " << rows[i].runs << ", \"pose_mae\": " << json_number(s.pose_mae)
+        << ", \"map_mae\": " << json_number(s.map_mae) << ", \"pose_nees_inside\": " << json_number(s.pose_nees_inside)
+        << ", \"map_nees_inside\": " << json_number(s.map_nees_inside) << ", \"pose_anees\": " << json_number(s.pose_anees)
+        << ", \"total_seconds\": " << json_number(s.total_seconds)
+        << ", \"seconds_per_step\": " << json_number(s.seconds_per_step) << "}" << (i + 1 < rows.size() ? ",\n" : "\n");
+  }
+  out << "]\n";
+}
+
+}  // namespace sextant::runner

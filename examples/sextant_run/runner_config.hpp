@@ -1,0 +1,234 @@
+#pragma once
+// sextant-run's settings: defaults, and an MRPT-style ini file (mrpt::config::CConfigFile) with one
+// section per back-end and per data source. Every key is declared once below, with its default and
+// its meaning; `sextant-run --print-config` prints them as an ini file (docs/runner.md holds that
+// output, checked by a test). An unknown section or key, or a value that does not parse, is an
+// error naming the file, the section and the key.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <mrpt/config/CConfigFile.h>
+#include <numbers>
+#include <sextant/backends/ekf_slam.hpp>
+#include <sextant/backends/fast_slam.hpp>
+#include <sextant/backends/graph_slam.hpp>
+#include <sextant/backends/seif_slam.hpp>
+#include <sextant/core/error.hpp>
+#include <sextant/mrpt/rawlog.hpp>
+#include <sextant/sim/ship_2d.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace sextant::runner {
+
+struct RunnerConfig {
+  sim::Ship2DOptions ship;
+  int ship_runs = 10;
+  mrpt_io::RawlogOptions rawlog;
+  EkfOptions ekf;
+  SeifOptions seif{.max_active = 8};
+  GraphOptions graph;
+  FastSlamOptions fastslam;
+  double scene_quantile = 3.0;
+};
+
+/// One settable key: where it lives, its default as text, what it means, how it is applied.
+struct ConfigKey {
+  std::string section, key, default_value, meaning;
+  std::function<void(RunnerConfig&, const std::string& value)> apply;
+};
+
+namespace detail {
+
+inline double parse_number(const std::string& text) {
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  while (used < text.size() && std::isspace(static_cast<unsigned char>(text[used]))) ++used;
+  if (used == 0 || used != text.size() || !std::isfinite(value)) throw invalid_input_error("'" + text + "' is not a finite number");
+  return value;
+}
+
+inline long long parse_integer(const std::string& text, long long min) {
+  const double value = parse_number(text);
+  if (value != std::floor(value) || value < static_cast<double>(min))
+    throw invalid_input_error("'" + text + "' is not an integer >= " + std::to_string(min));
+  return static_cast<long long>(value);
+}
+
+inline bool parse_bool(const std::string& text) {
+  if (text == "true" || text == "1" || text == "yes") return true;
+  if (text == "false" || text == "0" || text == "no") return false;
+  throw invalid_input_error("'" + text + "' is not true or false");
+}
+
+inline double positive(double value, const std::string& text) {
+  if (!(value > 0.0)) throw invalid_input_error("'" + text + "' must be positive");
+  return value;
+}
+
+/// The value without a trailing `// comment` (MRPT's ini files use them) and surrounding blanks.
+inline std::string without_comment(std::string value) {
+  if (const auto comment = value.find("//"); comment != std::string::npos) value.erase(comment);
+  const auto first = value.find_first_not_of(" \t\r");
+  const auto last = value.find_last_not_of(" \t\r");
+  return first == std::string::npos ? std::string() : value.substr(first, last - first + 1);
+}
+
+template <class Enum>
+Enum parse_choice(const std::string& text, std::initializer_list<std::pair<const char*, Enum>> choices) {
+  std::string names;
+  for (const auto& [name, value] : choices) {
+    if (text == name) return value;
+    names += names.empty() ? name : std::string("|") + name;
+  }
+  throw invalid_input_error("'" + text + "' is not one of " + names);
+}
+
+}  // namespace detail
+
+/// Every key sextant-run understands.
+inline const std::vector<ConfigKey>& config_keys() {
+  using namespace detail;
+  constexpr double deg = std::numbers::pi / 180.0;
+  static const std::vector<ConfigKey> keys = {
+      {"ship", "seed", "1", "first simulation seed of the 2D beacon-ship Monte Carlo runs",
+       [](RunnerConfig& c, const std::string& v) { c.ship.seed = static_cast<std::uint64_t>(parse_integer(v, 0)); }},
+      {"ship", "runs", "10", "Monte Carlo runs (seeds seed .. seed+runs-1); the table averages them",
+       [](RunnerConfig& c, const std::string& v) { c.ship_runs = static_cast<int>(parse_integer(v, 1)); }},
+      {"ship", "steps", "1390", "steps per run (thesis: 1390)",
+       [](RunnerConfig& c, const std::string& v) { c.ship.num_steps = static_cast<int>(parse_integer(v, 1)); }},
+      {"ship", "sigma_heading_deg", "15", "compass noise, degrees (thesis: 15)",
+       [](RunnerConfig& c, const std::string& v) { c.ship.sigma_heading = positive(parse_number(v), v) * deg; }},
+      {"ship", "sigma_beacon", "2", "beacon offset noise per axis, km",
+       [](RunnerConfig& c, const std::string& v) { c.ship.sigma_beacon = positive(parse_number(v), v); }},
+      {"rawlog", "std_range", "0", "range noise, m; 0 = as stated in the rawlog",
+       [](RunnerConfig& c, const std::string& v) {
+         const double x = parse_number(v);
+         c.rawlog.std_range = x > 0.0 ? std::optional<double>(x) : std::nullopt;
+       }},
+      {"rawlog", "std_yaw_deg", "0", "bearing (yaw) noise, degrees; 0 = as stated in the rawlog",
+       [](RunnerConfig& c, const std::string& v) {
+         const double x = parse_number(v);
+         c.rawlog.std_yaw = x > 0.0 ? std::optional<double>(x * deg) : std::nullopt;
+       }},
+      {"rawlog", "std_pitch_deg", "0", "pitch noise (3D), degrees; 0 = as stated in the rawlog",
+       [](RunnerConfig& c, const std::string& v) {
+         const double x = parse_number(v);
+         c.rawlog.std_pitch = x > 0.0 ? std::optional<double>(x * deg) : std::nullopt;
+       }},
+      {"rawlog", "odometry_std_xy", "0.1", "observation-only rawlogs: odometry noise per step along x and y, m",
+       [](RunnerConfig& c, const std::string& v) {
+         c.rawlog.odometry_std(0) = c.rawlog.odometry_std(1) = positive(parse_number(v), v);
+       }},
+      {"rawlog", "odometry_std_phi_deg", "4", "observation-only rawlogs: odometry heading noise per step, degrees",
+       [](RunnerConfig& c, const std::string& v) { c.rawlog.odometry_std(2) = positive(parse_number(v), v) * deg; }},
+      {"rawlog", "prior_std", "1e-06", "standard deviation of the start pose (the robot starts at the map origin)",
+       [](RunnerConfig& c, const std::string& v) { c.rawlog.prior_std = positive(parse_number(v), v); }},
+      {"rawlog", "max_steps", "0", "read at most this many steps; 0 = all",
+       [](RunnerConfig& c, const std::string& v) { c.rawlog.max_steps = static_cast<std::size_t>(parse_integer(v, 0)); }},
+      {"ekf", "batch_update", "true", "one joint correction per step (true) or one per observation (false)",
+       [](RunnerConfig& c, const std::string& v) { c.ekf.batch_update = parse_bool(v); }},
+      {"ekf", "covariance_update", "symmetric", "symmetric (lower-triangle rank update) | joseph",
+       [](RunnerConfig& c, const std::string& v) {
+         c.ekf.covariance_update =
+             parse_choice<CovarianceUpdate>(v, {{"symmetric", CovarianceUpdate::symmetric}, {"joseph", CovarianceUpdate::joseph}});
+       }},
+      {"ekf", "gate_probability", "0", "Mahalanobis gate: reject observations above this chi-square quantile; 0 = off",
+       [](RunnerConfig& c, const std::string& v) {
+         const double p = parse_number(v);
+         if (p < 0.0 || p >= 1.0) throw invalid_input_error("'" + v + "' must be in [0, 1)");
+         c.ekf.gate_probability = p;
+       }},
+      {"seif", "max_active", "8", "landmarks kept linked to the robot by sparsification; 0 = no sparsification",
+       [](RunnerConfig& c, const std::string& v) { c.seif.max_active = static_cast<std::size_t>(parse_integer(v, 0)); }},
+      {"seif", "mean_recovery", "active_block", "active_block (joint solve) | coordinate_descent (thesis)",
+       [](RunnerConfig& c, const std::string& v) {
+         c.seif.mean_recovery = parse_choice<MeanRecovery>(
+             v, {{"active_block", MeanRecovery::active_block}, {"coordinate_descent", MeanRecovery::coordinate_descent}});
+       }},
+      {"seif", "mean_recovery_sweeps", "1", "recovery sweeps per update",
+       [](RunnerConfig& c, const std::string& v) { c.seif.mean_recovery_sweeps = static_cast<int>(parse_integer(v, 0)); }},
+      {"seif", "exact_recovery_period", "0", "every K updates an exact solve of the whole mean; 0 = never",
+       [](RunnerConfig& c, const std::string& v) { c.seif.exact_recovery_period = static_cast<int>(parse_integer(v, 0)); }},
+      {"graph", "max_iterations", "10", "Gauss-Newton iterations at most",
+       [](RunnerConfig& c, const std::string& v) { c.graph.max_iterations = static_cast<int>(parse_integer(v, 1)); }},
+      {"graph", "solver", "automatic", "automatic | landmark_schur (thesis) | full (sparse Cholesky of everything)",
+       [](RunnerConfig& c, const std::string& v) {
+         c.graph.solver = parse_choice<GraphSolver>(v, {{"automatic", GraphSolver::automatic},
+                                           {"landmark_schur", GraphSolver::landmark_schur},
+                                           {"full", GraphSolver::full}});
+       }},
+      {"graph", "levenberg_marquardt", "false", "damp the Gauss-Newton steps",
+       [](RunnerConfig& c, const std::string& v) { c.graph.levenberg_marquardt = parse_bool(v); }},
+      {"graph", "window", "0", "windowed initialization: optimize growing parts of this many steps first; 0 = off",
+       [](RunnerConfig& c, const std::string& v) { c.graph.window = static_cast<std::size_t>(parse_integer(v, 0)); }},
+      {"fastslam", "particles", "50", "particles",
+       [](RunnerConfig& c, const std::string& v) { c.fastslam.particles = static_cast<std::size_t>(parse_integer(v, 1)); }},
+      {"fastslam", "resample_threshold", "0.5", "resample when N_eff < threshold * particles (1 = always, 0 = never)",
+       [](RunnerConfig& c, const std::string& v) {
+         const double t = parse_number(v);
+         if (t < 0.0 || t > 1.0) throw invalid_input_error("'" + v + "' must be in [0, 1]");
+         c.fastslam.resample_threshold = t;
+       }},
+      {"fastslam", "map_estimate", "best_particle", "best_particle | weighted_average (moment-matched over particles)",
+       [](RunnerConfig& c, const std::string& v) {
+         c.fastslam.map_estimate =
+             parse_choice<FastSlamMap>(v, {{"best_particle", FastSlamMap::best_particle}, {"weighted_average", FastSlamMap::weighted_average}});
+       }},
+      {"fastslam", "seed", "1", "random seed",
+       [](RunnerConfig& c, const std::string& v) { c.fastslam.seed = static_cast<std::uint64_t>(parse_integer(v, 0)); }},
+      {"scene", "quantile", "3", "size of the covariance ellipses in the .3Dscene, standard deviations",
+       [](RunnerConfig& c, const std::string& v) { c.scene_quantile = positive(parse_number(v), v); }},
+  };
+  return keys;
+}
+
+/// The defaults as an ini file, every key with its meaning.
+inline std::string documented_defaults() {
+  std::ostringstream out;
+  std::string section;
+  for (const auto& k : config_keys()) {
+    if (k.section != section) {
+      out << (section.empty() ? "" : "\n") << "[" << k.section << "]\n";
+      section = k.section;
+    }
+    out << "# " << k.meaning << "\n" << k.key << " = " << k.default_value << "\n";
+  }
+  return out.str();
+}
+
+/// The defaults, overridden by the file's keys; throws invalid_input_error "file: [section] key: problem".
+inline RunnerConfig load_config(const std::string& path) {
+  RunnerConfig config;
+  for (const auto& k : config_keys()) k.apply(config, k.default_value);
+  if (path.empty()) return config;
+  if (!std::filesystem::is_regular_file(path)) throw invalid_input_error(path + ": cannot open config file");
+  ::mrpt::config::CConfigFile file(path);
+  std::vector<std::string> sections;
+  file.getAllSections(sections);
+  for (const auto& section : sections) {
+    std::vector<std::string> names;
+    file.getAllKeys(section, names);
+    for (const auto& name : names) {
+      const auto it = std::find_if(config_keys().begin(), config_keys().end(),
+                                   [&](const ConfigKey& k) { return k.section == section && k.key == name; });
+      const std::string where = path + ": [" + section + "] " + name;
+      if (it == config_keys().end()) throw invalid_input_error(where + ": unknown key (see sextant-run --print-config)");
+      try {
+        it->apply(config, detail::without_comment(file.read_string(section, name, "", true)));
+      } catch (const std::exception& e) {
+        throw invalid_input_error(where + ": " + e.what());
+      }
+    }
+  }
+  return config;
+}
+
+}  // namespace sextant::runner
