@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian packages sextant needs to build, test and benchmark, if any are missing.
 set -euo pipefail
-packages=(cmake make g++ libeigen3-dev libboost-dev libgtest-dev libbenchmark-dev libcli11-dev libsuitesparse-dev libceres-dev)
+# libmrpt-dev: rawlogs, 3D scenes, CConfigFile; mrpt-common: the kf-slam demo rawlogs; python3-matplotlib: --plots
+packages=(cmake make g++ libeigen3-dev libboost-dev libgtest-dev libbenchmark-dev libcli11-dev libsuitesparse-dev libceres-dev
+          libmrpt-dev mrpt-common python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

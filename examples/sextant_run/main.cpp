@@ -122,21 +122,26 @@ std::vector<TableRow> run_ship(const Options& options, const std::vector<Backend
   return rows;
 }
 
-/// A rawlog with the MRPT ground-truth files beside it, as planar or spatial.
-std::vector<TableRow> run_rawlog(const Options& options, const std::string& path, const std::vector<BackendKind>& kinds,
-                                 const RunnerConfig& config) {
+/// The ground-truth files beside a rawlog, which sextant-run needs to score the runs.
+mrpt_io::GroundTruthFiles require_ground_truth(const std::string& path) {
   const auto truth = mrpt_io::find_ground_truth(path);
   if (!truth)
     throw parse_error(path + ": no ground truth beside it (<name>_ground_truth.txt and "
                              "<name>_ground_truth_robot_path.txt); sextant-run scores against ground truth");
+  return *truth;
+}
+
+/// A rawlog with the MRPT ground-truth files beside it, as planar or spatial.
+std::vector<TableRow> run_rawlog(const Options& options, const std::string& path, const std::vector<BackendKind>& kinds,
+                                 const RunnerConfig& config) {
   const std::string name = std::filesystem::path(path).filename().string();
   if (mrpt_io::detect_rawlog_kind(path, config.rawlog) == mrpt_io::RawlogKind::planar) {
     auto data = mrpt_io::read_rawlog_2d(path, config.rawlog);
-    mrpt_io::attach_ground_truth(data, *truth);
+    mrpt_io::attach_ground_truth(data, require_ground_truth(path));
     return run_dataset(options, name, data, kinds, config, {2, 3, 2}, "m");
   }
   auto data = mrpt_io::read_rawlog_3d(path, config.rawlog);
-  mrpt_io::attach_ground_truth(data, *truth);
+  mrpt_io::attach_ground_truth(data, require_ground_truth(path));
   return run_dataset(options, name, data, kinds, config, {3, 6, 3}, "m");
 }
 

@@ -81,10 +81,14 @@ enum class RawlogKind { planar, spatial };
 
 namespace detail {
 
-/// One line of an exception's text (MRPT's carry a call trace below it).
+/// One line of an exception's text: MRPT's start with a banner, then "Message: ...", then a call
+/// trace; the message line is the one worth showing.
 inline std::string first_line(const std::string& text) {
-  const auto end = text.find('\n');
-  std::string line = text.substr(0, end);
+  std::size_t start = 0;
+  if (const auto message = text.find("Message:"); message != std::string::npos) start = message + 8;
+  std::string line = text.substr(start, text.find('\n', start) - start);
+  const auto first = line.find_first_not_of(" \t");
+  line = first == std::string::npos ? std::string() : line.substr(first);
   while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
   return line.empty() ? "unreadable data" : line;
 }

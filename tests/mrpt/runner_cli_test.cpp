@@ -1,0 +1,181 @@
+// sextant-run as a user meets it: a run writes the promised files, its .3Dscene loads back in MRPT,
+// and bad input (missing, truncated or malformed rawlog, unknown config key or value) ends with a
+// non-zero exit and one line naming the file and the problem.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mrpt/opengl/CEllipsoid2D.h>
+#include <mrpt/opengl/CEllipsoid3D.h>
+#include <mrpt/opengl/COpenGLScene.h>
+#include <mrpt/opengl/CPointCloud.h>
+#include <mrpt/opengl/CSetOfLines.h>
+#include <mrpt/opengl/CSetOfObjects.h>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+#include "mrpt/mrpt_demo_data.hpp"
+#include "sextant/mrpt/scene.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using sextant::testing::mrpt_demo;
+
+struct Result {
+  int exit_code;
+  std::string out, err;
+};
+
+Result run_runner(const std::string& arguments, const fs::path& dir) {
+  const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string command = std::string(SEXTANT_RUN_EXE) + " " + arguments + " >" + out.string() + " 2>" + err.string();
+  const int status = std::system(command.c_str());
+  auto slurp = [](const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+}
+
+class RunnerCli : public ::testing::Test {
+ protected:
+  fs::path dir = fs::temp_directory_path() / ("sextant_run_cli_" + std::to_string(::getpid()) + "_" +
+                                              ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  void SetUp() override { fs::create_directories(dir); }
+  void TearDown() override { fs::remove_all(dir); }
+
+  /// Expects failure with exactly one line on stderr that contains every fragment.
+  void expect_one_line_error(const std::string& arguments, const std::vector<std::string>& fragments) {
+    const auto r = run_runner(arguments, dir);
+    EXPECT_NE(r.exit_code, 0) << arguments;
+    ASSERT_FALSE(r.err.empty()) << arguments;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "not one line: " << r.err;
+    for (const auto& f : fragments) EXPECT_NE(r.err.find(f), std::string::npos) << "'" << f << "' not in: " << r.err;
+  }
+
+  /// A copy of a demo rawlog and its ground truth under a new name in `dir`.
+  fs::path copy_demo(const std::string& demo, const std::string& name) {
+    const fs::path source = mrpt_demo(demo);
+    const auto stem = source.parent_path() / source.stem();
+    fs::copy_file(source, dir / (name + ".rawlog"));
+    fs::copy_file(stem.string() + "_ground_truth.txt", dir / (name + "_ground_truth.txt"));
+    fs::copy_file(stem.string() + "_ground_truth_robot_path.txt", dir / (name + "_ground_truth_robot_path.txt"));
+    return dir / (name + ".rawlog");
+  }
+};
+
+TEST_F(RunnerCli, PlanarRunWritesTableCsvTumJsonAndALoadableScene) {
+  SEXTANT_REQUIRE_MRPT_DEMO("kf-slam_demo.rawlog");
+  const auto out = dir / "out";
+  const auto r = run_runner("--dataset " + mrpt_demo("kf-slam_demo.rawlog") + " --backend ekf,fastslam2 --out " + out.string(), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("EKF-SLAM"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("FastSLAM 2.0"), std::string::npos) << r.out;
+  for (const char* file : {"ekf_steps.csv", "ekf_map.csv", "ekf_trajectory.tum", "ground_truth.tum", "ekf.3Dscene",
+                           "fastslam2.3Dscene"})
+    EXPECT_TRUE(fs::exists(out / "kf-slam_demo" / file)) << file;
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
+
+  mrpt::opengl::COpenGLScene scene;
+  ASSERT_TRUE(scene.loadFromFile((out / "kf-slam_demo" / "ekf.3Dscene").string()));
+  const auto path = std::dynamic_pointer_cast<mrpt::opengl::CSetOfLines>(scene.getByName(sextant::mrpt_io::scene_names::estimated_path));
+  ASSERT_TRUE(path);
+  EXPECT_EQ(path->size(), 248u);  // 249 poses
+  ASSERT_TRUE(scene.getByName(sextant::mrpt_io::scene_names::true_path));
+  const auto landmarks = std::dynamic_pointer_cast<mrpt::opengl::CSetOfObjects>(scene.getByName(sextant::mrpt_io::scene_names::landmarks));
+  ASSERT_TRUE(landmarks);
+  std::size_t ellipses = 0;
+  for (const auto& object : *landmarks) ellipses += std::dynamic_pointer_cast<mrpt::opengl::CEllipsoid2D>(object) != nullptr;
+  EXPECT_EQ(ellipses, 70u);
+  EXPECT_TRUE(landmarks->getByName("landmark 7"));
+
+  ASSERT_TRUE(scene.loadFromFile((out / "kf-slam_demo" / "fastslam2.3Dscene").string()));
+  const auto particles = std::dynamic_pointer_cast<mrpt::opengl::CPointCloud>(scene.getByName(sextant::mrpt_io::scene_names::particles));
+  ASSERT_TRUE(particles);
+  EXPECT_EQ(particles->size(), 50u);
+}
+
+TEST_F(RunnerCli, SpatialRunDrawsLandmarkEllipsoids) {
+  SEXTANT_REQUIRE_MRPT_DEMO("kf-slam_6D_demo_noncentered.rawlog");
+  const auto out = dir / "out";
+  const auto r = run_runner("-d " + mrpt_demo("kf-slam_6D_demo_noncentered.rawlog") + " -b ekf -o " + out.string(), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  mrpt::opengl::COpenGLScene scene;
+  ASSERT_TRUE(scene.loadFromFile((out / "kf-slam_6D_demo_noncentered" / "ekf.3Dscene").string()));
+  const auto landmarks = std::dynamic_pointer_cast<mrpt::opengl::CSetOfObjects>(scene.getByName(sextant::mrpt_io::scene_names::landmarks));
+  ASSERT_TRUE(landmarks);
+  std::size_t ellipsoids = 0;
+  for (const auto& object : *landmarks) ellipsoids += std::dynamic_pointer_cast<mrpt::opengl::CEllipsoid3D>(object) != nullptr;
+  EXPECT_GT(ellipsoids, 40u);
+}
+
+TEST_F(RunnerCli, PlotsAreWritten) {
+  SEXTANT_REQUIRE_MRPT_DEMO("kf-slam_demo.rawlog");
+  const auto out = dir / "out";
+  const auto r = run_runner("-d " + mrpt_demo("kf-slam_demo.rawlog") + " -b ekf --plots -o " + out.string(), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_GT(fs::file_size(out / "kf-slam_demo" / "ekf_map.png"), 10000u);
+  EXPECT_GT(fs::file_size(out / "kf-slam_demo" / "ekf_errors.png"), 10000u);
+}
+
+TEST_F(RunnerCli, BadRawlogsEndWithOneLineNamingFileAndProblem) {
+  SEXTANT_REQUIRE_MRPT_DEMO("kf-slam_demo.rawlog");
+  const auto missing = (dir / "missing.rawlog").string();
+  expect_one_line_error("-d " + missing, {missing, "cannot open file"});
+
+  const auto truncated = copy_demo("kf-slam_demo.rawlog", "truncated");
+  fs::resize_file(truncated, fs::file_size(truncated) / 2);
+  expect_one_line_error("-d " + truncated.string(), {truncated.string(), "truncated or malformed"});
+
+  const auto garbage = dir / "garbage.rawlog";
+  std::ofstream(garbage) << "definitely not an MRPT rawlog\n";
+  expect_one_line_error("-d " + garbage.string(), {garbage.string(), "truncated or malformed"});
+
+  const auto no_truth = dir / "no_truth.rawlog";
+  fs::copy_file(mrpt_demo("kf-slam_demo.rawlog"), no_truth);
+  expect_one_line_error("-d " + no_truth.string(), {no_truth.string(), "no ground truth"});
+}
+
+TEST_F(RunnerCli, BadConfigEndsWithOneLineNamingFileKeyAndProblem) {
+  const auto ini = (dir / "bad.ini").string();
+  std::ofstream(ini) << "[ekf]\nbatch_update = true\ngate_probabilty = 0.99\n";
+  expect_one_line_error("-d ship -c " + ini, {ini, "[ekf] gate_probabilty", "unknown key"});
+
+  std::ofstream(ini) << "[seif]\nmax_active = lots\n";
+  expect_one_line_error("-d ship -c " + ini, {ini, "[seif] max_active", "'lots' is not a finite number"});
+
+  std::ofstream(ini) << "[nonsense]\nkey = 1\n";
+  expect_one_line_error("-d ship -c " + ini, {ini, "[nonsense] key", "unknown key"});
+
+  const auto missing = (dir / "missing.ini").string();
+  expect_one_line_error("-d ship -c " + missing, {missing, "cannot open config file"});
+
+  expect_one_line_error("-d ship -b kalman", {"--backend", "unknown back-end 'kalman'"});
+}
+
+TEST_F(RunnerCli, ConfigReferenceInDocsIsThePrintedDefaults) {
+  const auto r = run_runner("--print-config", dir);
+  ASSERT_EQ(r.exit_code, 0);
+  std::ifstream docs(SEXTANT_RUNNER_DOCS);
+  std::stringstream text;
+  text << docs.rdbuf();
+  EXPECT_NE(text.str().find("```ini\n" + r.out + "```"), std::string::npos)
+      << "docs/runner.md must hold the output of sextant-run --print-config in an ini block";
+}
+
+TEST_F(RunnerCli, IniValuesReachTheBackEnds) {
+  const auto ini = (dir / "good.ini").string();
+  std::ofstream(ini) << "[ship]\nruns = 2\nsteps = 60\n[seif]\nmax_active = 3   // MRPT-style comment\n[fastslam]\nparticles = 7\n";
+  const auto r = run_runner("-d ship -b seif,fastslam1 -c " + ini, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("60 steps, 2 Monte Carlo run(s)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("SEIF-SLAM, 3 active"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("FastSLAM 1.0, 7 particles"), std::string::npos) << r.out;
+}
+
+}  // namespace
