@@ -10,6 +10,9 @@
 
 #include "mrpt/mrpt_demo_data.hpp"
 #include "sextant/backends/ekf_slam.hpp"
+#include "sextant/backends/fast_slam.hpp"
+#include "sextant/backends/graph_slam.hpp"
+#include "sextant/backends/seif_slam.hpp"
 #include "sextant/eval/experiment.hpp"
 
 namespace sextant::mrpt_io {
@@ -73,6 +76,25 @@ TEST(KfSlam6dDemos, SensorModelReproducesTheMeasurementsFromGroundTruth) {
     attach_ground_truth(data, *find_ground_truth(data.path));
     EXPECT_LT(worst_normalized_residual_at_truth(data, 50), 5.0);
   }
+}
+
+TEST(KfSlam6dDemos, EveryBackEndMapsTheSpatialDemo) {
+  SEXTANT_REQUIRE_MRPT_DEMO("kf-slam_6D_demo.rawlog");
+  auto data = read_rawlog_3d(testing::mrpt_demo("kf-slam_6D_demo.rawlog"));
+  attach_ground_truth(data, *find_ground_truth(data.path));
+  using Motion = Se3Odometry;
+  using Sensor = RangeBearing3D;
+  // Sanity bounds, an order of magnitude above what each reaches (docs/results/mrpt_comparison.md).
+  EkfSlam<Motion, Sensor> ekf(data.motion, data.sensor, data.prior);
+  EXPECT_LT(eval::mean(eval::evaluate_run(ekf, data, 3).map_error), 0.05);
+  SeifSlam<Motion, Sensor> seif(data.motion, data.sensor, data.prior, {.max_active = 8});
+  EXPECT_LT(eval::mean(eval::evaluate_run(seif, data, 3).map_error), 0.05);
+  GraphSlam<Motion, Sensor> graph(data.motion, data.sensor, data.prior);
+  EXPECT_LT(eval::mean(eval::evaluate_smoothed_run(graph, data, 3).map_error), 0.05);
+  FastSlam<Motion, Sensor> fast(data.motion, data.sensor, data.prior, {.particles = 20});
+  const auto fast_run = eval::evaluate_run(fast, data, 3);
+  EXPECT_EQ(fast_run.map_error.size(), ekf.map().size());
+  EXPECT_LT(eval::mean(fast_run.map_error), 1.0);
 }
 
 // ---- Logs written here with MRPT's own serialization --------------------------------------------
