@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <sextant/backends/ekf_slam.hpp>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "experiments.hpp"
@@ -135,14 +136,14 @@ mrpt_io::GroundTruthFiles require_ground_truth(const std::string& path) {
 std::vector<TableRow> run_rawlog(const Options& options, const std::string& path, const std::vector<BackendKind>& kinds,
                                  const RunnerConfig& config) {
   const std::string name = std::filesystem::path(path).filename().string();
-  if (mrpt_io::detect_rawlog_kind(path, config.rawlog) == mrpt_io::RawlogKind::planar) {
-    auto data = mrpt_io::read_rawlog_2d(path, config.rawlog);
-    mrpt_io::attach_ground_truth(data, require_ground_truth(path));
-    return run_dataset(options, name, data, kinds, config, {2, 3, 2}, "m");
-  }
-  auto data = mrpt_io::read_rawlog_3d(path, config.rawlog);
-  mrpt_io::attach_ground_truth(data, require_ground_truth(path));
-  return run_dataset(options, name, data, kinds, config, {3, 6, 3}, "m");
+  auto dataset = mrpt_io::read_rawlog(path, config.rawlog);
+  return std::visit(
+      [&](auto& data) {
+        mrpt_io::attach_ground_truth(data, require_ground_truth(path));
+        constexpr bool planar = std::decay_t<decltype(data)>::Motion::kDim == 3;
+        return run_dataset(options, name, data, kinds, config, planar ? Scoring{2, 3, 2} : Scoring{3, 6, 3}, "m");
+      },
+      dataset);
 }
 
 std::string one_line(const std::string& text) {

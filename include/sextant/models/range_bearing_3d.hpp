@@ -26,8 +26,7 @@ struct RangeBearing3D {
     const auto f = value_and_jacobian<3>(
         [this](const auto& a) {
           using Scalar = typename std::decay_t<decltype(a)>::Scalar;
-          const Pose3Euler<Scalar> sensor = compose<Scalar>(a.template head<6>(), sensor_pose.cast<Scalar>());
-          return spherical<Scalar>(point_in_frame<Scalar>(sensor, a.template tail<3>()));
+          return spherical<Scalar>(point_in_frame<Scalar>(sensor_in_world<Scalar>(a.template head<6>()), a.template tail<3>()));
         },
         arguments);
     MeasurementPrediction<3, 6, 3> out;
@@ -51,7 +50,7 @@ struct RangeBearing3D {
           using Scalar = typename std::decay_t<decltype(a)>::Scalar;
           using std::cos;
           using std::sin;
-          const Pose3Euler<Scalar> sensor = compose<Scalar>(a.template head<6>(), sensor_pose.cast<Scalar>());
+          const Pose3Euler<Scalar> sensor = sensor_in_world<Scalar>(a.template head<6>());
           const Scalar r = a(6), yaw = a(7), pitch = a(8);
           const Eigen::Matrix<Scalar, 3, 1> local(r * cos(pitch) * cos(yaw), r * cos(pitch) * sin(yaw), -r * sin(pitch));
           return Eigen::Matrix<Scalar, 3, 1>(sensor.template head<3>() + rotation_of(sensor) * local);
@@ -63,6 +62,12 @@ struct RangeBearing3D {
     out.J_m_z = f.jacobian.rightCols<3>();
     out.Q = Q;
     return out;
+  }
+
+  /// The sensor's pose in the world: robot (+) mount.
+  template <class Scalar>
+  Pose3Euler<Scalar> sensor_in_world(const Pose3Euler<Scalar>& robot) const {
+    return compose<Scalar>(robot, sensor_pose.cast<Scalar>());
   }
 
   /// (range, yaw, pitch) of a point in the sensor frame.

@@ -30,6 +30,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "sextant/core/error.hpp"
@@ -288,30 +289,27 @@ inline double step_dt(const std::vector<RawStep>& steps, std::size_t k) {
 
 }  // namespace detail
 
-/// Planar or spatial: spatial as soon as the log has 3D odometry or a nonzero pitch.
-inline RawlogKind detect_rawlog_kind(const std::string& path, const RawlogOptions& options = {}) {
-  detail::RawlogParser parser(path);
-  const auto steps = parser.parse(options);
+namespace detail {
+
+/// Spatial as soon as the log has 3D odometry, a nonzero pitch or a sensor mounted out of the plane.
+inline bool is_spatial(const std::vector<RawStep>& steps, const SensorDescription& sensor) {
   for (const auto& step : steps) {
-    if (!step.planar_odometry) return RawlogKind::spatial;
+    if (!step.planar_odometry) return true;
     for (const auto& s : step.sightings)
-      if (s.range_yaw_pitch(2) != 0.0) return RawlogKind::spatial;
+      if (s.range_yaw_pitch(2) != 0.0) return true;
   }
-  return parser.sensor().mount.tail<2>().isZero() && parser.sensor().mount(2) == 0.0 ? RawlogKind::planar
-                                                                                      : RawlogKind::spatial;
+  return sensor.mount(2) != 0.0 || !sensor.mount.tail<2>().isZero();
 }
 
-/// Reads a planar rawlog: (x, y, heading) robot, 2D odometry (3D odometry is projected onto the
-/// plane), range and bearing. A nonzero pitch is an error.
-inline RawlogDataset2D read_rawlog_2d(const std::string& path, const RawlogOptions& options = {}) {
-  detail::RawlogParser parser(path);
-  const auto raw = parser.parse(options);
-  const auto& sensor = parser.sensor();
+/// The parsed log as planar steps: (x, y, heading) odometry (3D odometry projected onto the
+/// plane), range and bearing; a nonzero pitch is an error.
+inline RawlogDataset2D to_planar(const std::string& path, const std::vector<RawStep>& raw, const SensorDescription& sensor,
+                                 const RawlogOptions& options) {
   RawlogDataset2D out;
   out.path = path;
   out.sensor.sensor_pose << sensor.mount(0), sensor.mount(1), sensor.mount(3);
-  const double sr = detail::noise_std(options.std_range, sensor.std_range_yaw_pitch(0), path, "range");
-  const double sy = detail::noise_std(options.std_yaw, sensor.std_range_yaw_pitch(1), path, "yaw");
+  const double sr = noise_std(options.std_range, sensor.std_range_yaw_pitch(0), path, "range");
+  const double sy = noise_std(options.std_yaw, sensor.std_range_yaw_pitch(1), path, "yaw");
   out.sensor.Q = Eigen::Vector2d(sr * sr, sy * sy).asDiagonal();
   out.prior.mean.setZero();
   out.prior.cov = Eigen::Matrix3d::Identity() * options.prior_std * options.prior_std;
@@ -322,7 +320,7 @@ inline RawlogDataset2D read_rawlog_2d(const std::string& path, const RawlogOptio
       step.control.delta(r) = raw[k].delta(planar[r]);
       for (int c = 0; c < 3; ++c) step.control.cov(r, c) = raw[k].cov(planar[r], planar[c]);
     }
-    step.dt = detail::step_dt(raw, k);
+    step.dt = step_dt(raw, k);
     for (const auto& s : raw[k].sightings) {
       if (s.range_yaw_pitch(2) != 0.0)
         throw parse_error(path + ": step " + std::to_string(k) + ": landmark " + std::to_string(s.id) +
@@ -334,18 +332,15 @@ inline RawlogDataset2D read_rawlog_2d(const std::string& path, const RawlogOptio
   return out;
 }
 
-/// Reads a spatial rawlog: 6D robot, 6D odometry, range, yaw and pitch. 2D odometry is read as a
-/// motion in the plane z = 0 with zero variance out of the plane, which a filter cannot use.
-inline RawlogDataset3D read_rawlog_3d(const std::string& path, const RawlogOptions& options = {}) {
-  detail::RawlogParser parser(path);
-  const auto raw = parser.parse(options);
-  const auto& sensor = parser.sensor();
+/// The parsed log as spatial steps: 6D odometry, range, yaw and pitch; 2D odometry is an error.
+inline RawlogDataset3D to_spatial(const std::string& path, const std::vector<RawStep>& raw,
+                                  const SensorDescription& sensor, const RawlogOptions& options) {
   RawlogDataset3D out;
   out.path = path;
   out.sensor.sensor_pose = sensor.mount;
-  const double sr = detail::noise_std(options.std_range, sensor.std_range_yaw_pitch(0), path, "range");
-  const double sy = detail::noise_std(options.std_yaw, sensor.std_range_yaw_pitch(1), path, "yaw");
-  const double sp = detail::noise_std(options.std_pitch, sensor.std_range_yaw_pitch(2), path, "pitch");
+  const double sr = noise_std(options.std_range, sensor.std_range_yaw_pitch(0), path, "range");
+  const double sy = noise_std(options.std_yaw, sensor.std_range_yaw_pitch(1), path, "yaw");
+  const double sp = noise_std(options.std_pitch, sensor.std_range_yaw_pitch(2), path, "pitch");
   out.sensor.Q = Eigen::Vector3d(sr * sr, sy * sy, sp * sp).asDiagonal();
   out.prior.mean.setZero();
   out.prior.cov = Matrix6d::Identity() * options.prior_std * options.prior_std;
@@ -355,11 +350,44 @@ inline RawlogDataset3D read_rawlog_3d(const std::string& path, const RawlogOptio
     Step<OdometryIncrement3D, Eigen::Vector3d> step;
     step.control.delta = raw[k].delta;
     step.control.cov = raw[k].cov;
-    step.dt = detail::step_dt(raw, k);
+    step.dt = step_dt(raw, k);
     for (const auto& s : raw[k].sightings) step.observations.push_back({s.id, s.range_yaw_pitch});
     out.steps.push_back(std::move(step));
   }
   return out;
+}
+
+}  // namespace detail
+
+/// Planar or spatial: spatial as soon as the log has 3D odometry or a nonzero pitch.
+inline RawlogKind detect_rawlog_kind(const std::string& path, const RawlogOptions& options = {}) {
+  detail::RawlogParser parser(path);
+  const auto raw = parser.parse(options);
+  return detail::is_spatial(raw, parser.sensor()) ? RawlogKind::spatial : RawlogKind::planar;
+}
+
+/// Reads a planar rawlog: (x, y, heading) robot, 2D odometry (3D odometry is projected onto the
+/// plane), range and bearing. A nonzero pitch is an error.
+inline RawlogDataset2D read_rawlog_2d(const std::string& path, const RawlogOptions& options = {}) {
+  detail::RawlogParser parser(path);
+  const auto raw = parser.parse(options);
+  return detail::to_planar(path, raw, parser.sensor(), options);
+}
+
+/// Reads a spatial rawlog: 6D robot, 6D odometry, range, yaw and pitch. 2D odometry is an error.
+inline RawlogDataset3D read_rawlog_3d(const std::string& path, const RawlogOptions& options = {}) {
+  detail::RawlogParser parser(path);
+  const auto raw = parser.parse(options);
+  return detail::to_spatial(path, raw, parser.sensor(), options);
+}
+
+/// Reads a rawlog once as whichever it is, planar or spatial (see detect_rawlog_kind).
+inline std::variant<RawlogDataset2D, RawlogDataset3D> read_rawlog(const std::string& path,
+                                                                  const RawlogOptions& options = {}) {
+  detail::RawlogParser parser(path);
+  const auto raw = parser.parse(options);
+  if (detail::is_spatial(raw, parser.sensor())) return detail::to_spatial(path, raw, parser.sensor(), options);
+  return detail::to_planar(path, raw, parser.sensor(), options);
 }
 
 /// The ground-truth files MRPT ships beside a demo rawlog: `<stem>_ground_truth.txt` (map) and
