@@ -3,6 +3,7 @@
 // ANEES (the thesis could not compute it). Prints a Markdown table (docs/results/fastslam_particles.md).
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <vector>
 #include <sextant/sextant.hpp>
 
 int main(int argc, char** argv) {
@@ -16,6 +17,11 @@ int main(int argc, char** argv) {
   app.add_option("--resample-threshold", resample_threshold, "resample when N_eff < threshold * N")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
+  std::vector<std::size_t> particle_counts{5, 10, 20, 50, 100, 300, 1000};
+  app.add_option("--particles", particle_counts, "particle counts (comma-separated)")->delimiter(',')->capture_default_str();
+  std::vector<int> versions{1, 2};
+  app.add_option("--version", versions, "FastSLAM versions (1, 2 or 1,2)")->delimiter(',')->check(CLI::IsMember({1, 2}))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   // Thesis Table 7, FastSLAM 2.0 (its units say m; the data is in km like Tables 4-6).
   const std::map<std::size_t, std::pair<double, double>> thesis{
@@ -25,8 +31,9 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(options.seed + runs - 1));
     std::printf("| version | particles | pose MAE [km] | map MAE [km] | pose ANEES [95%% interval] | pose NEES <= 5.991 "
                 "| per step [us] | thesis 2.0 pose / map MAE |\n|---|---|---|---|---|---|---|---|\n");
-    for (FastSlamVersion version : {FastSlamVersion::v1, FastSlamVersion::v2}) {
-      for (std::size_t particles : {5u, 10u, 20u, 50u, 100u, 300u, 1000u}) {
+    for (int version_number : versions) {
+      const FastSlamVersion version = version_number == 1 ? FastSlamVersion::v1 : FastSlamVersion::v2;
+      for (std::size_t particles : particle_counts) {
         const auto results = eval::monte_carlo(runs, options.seed, [&](std::uint64_t seed) {
           sim::Ship2DOptions o = options;
           o.seed = seed;
