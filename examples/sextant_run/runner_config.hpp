@@ -15,6 +15,7 @@
 #include <sextant/backends/graph_slam.hpp>
 #include <sextant/backends/seif_slam.hpp>
 #include <sextant/core/error.hpp>
+#include <sextant/io/parse_number.hpp>
 #include <sextant/mrpt/rawlog.hpp>
 #include <sextant/sim/ship_2d.hpp>
 #include <sstream>
@@ -43,16 +44,9 @@ struct ConfigKey {
 namespace detail {
 
 inline double parse_number(const std::string& text) {
-  std::size_t used = 0;
-  double value = 0.0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  while (used < text.size() && std::isspace(static_cast<unsigned char>(text[used]))) ++used;
-  if (used == 0 || used != text.size() || !std::isfinite(value)) throw invalid_input_error("'" + text + "' is not a finite number");
-  return value;
+  const auto value = io::parse_finite_number(text);
+  if (!value) throw invalid_input_error("'" + text + "' is not a finite number");
+  return *value;
 }
 
 inline long long parse_integer(const std::string& text, long long min) {

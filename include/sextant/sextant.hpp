@@ -1,6 +1,7 @@
 #pragma once
 /// \file Umbrella header: everything in the core library (no MRPT, no OpenCV).
 
+#include "sextant/core/autodiff.hpp"
 #include "sextant/core/chi_square.hpp"
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/error.hpp"
@@ -11,6 +12,7 @@
 #include "sextant/core/model_results.hpp"
 #include "sextant/core/observation.hpp"
 #include "sextant/core/persistent_array.hpp"
+#include "sextant/core/pose3_euler_space.hpp"
 #include "sextant/core/se2_space.hpp"
 #include "sextant/core/selected_inverse.hpp"
 #include "sextant/core/sparse_cholesky.hpp"
@@ -21,7 +23,10 @@
 #include "sextant/core/validation.hpp"
 #include "sextant/models/beacon_ship_2d.hpp"
 #include "sextant/models/point_in_robot_frame_2d.hpp"
+#include "sextant/models/range_bearing_2d.hpp"
+#include "sextant/models/range_bearing_3d.hpp"
 #include "sextant/models/se2_odometry.hpp"
+#include "sextant/models/se3_odometry.hpp"
 #include "sextant/backends/ekf_slam.hpp"
 #include "sextant/backends/seif_slam.hpp"
 #include "sextant/backends/graph_slam.hpp"
@@ -32,6 +37,8 @@
 #include "sextant/eval/runner.hpp"
 #include "sextant/io/csv_writer.hpp"
 #include "sextant/io/isam_reader.hpp"
+#include "sextant/io/kf_slam_ground_truth.hpp"
+#include "sextant/io/parse_number.hpp"
 #include "sextant/io/tum_writer.hpp"
 #include "sextant/sim/ship_2d.hpp"
 #include "sextant/testing/model_checks.hpp"

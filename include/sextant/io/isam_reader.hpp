@@ -17,6 +17,7 @@
 
 #include "sextant/core/error.hpp"
 #include "sextant/core/observation.hpp"
+#include "sextant/io/parse_number.hpp"
 #include "sextant/models/point_in_robot_frame_2d.hpp"
 #include "sextant/models/se2_odometry.hpp"
 
@@ -85,15 +86,9 @@ inline PlanarDataset read_isam_2d(const std::string& path, IsamNoise form) {
     for (std::string word; fields >> word;) words.push_back(word);
     std::vector<double> values;
     for (const auto& word : words) {
-      std::size_t used = 0;
-      double value = 0.0;
-      try {
-        value = std::stod(word, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != word.size() || !std::isfinite(value)) throw parse_error(where + ": '" + word + "' is not a finite number");
-      values.push_back(value);
+      const auto value = parse_finite_number(word);
+      if (!value) throw parse_error(where + ": '" + word + "' is not a finite number");
+      values.push_back(*value);
     }
     auto require_fields = [&](std::size_t count) {
       if (values.size() != count)

@@ -14,6 +14,7 @@
 
 #include "sextant/core/error.hpp"
 #include "sextant/core/observation.hpp"
+#include "sextant/io/parse_number.hpp"
 
 namespace sextant::io {
 
@@ -33,16 +34,9 @@ inline std::vector<std::pair<int, std::vector<double>>> read_numeric_rows(const 
     std::vector<double> values;
     std::string token;
     while (fields >> token) {
-      std::size_t used = 0;
-      double value = 0.0;
-      try {
-        value = std::stod(token, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != token.size() || !std::isfinite(value))
-        throw parse_error(path + ":" + std::to_string(number) + ": '" + token + "' is not a finite number");
-      values.push_back(value);
+      const auto value = parse_finite_number(token);
+      if (!value) throw parse_error(path + ":" + std::to_string(number) + ": '" + token + "' is not a finite number");
+      values.push_back(*value);
     }
     rows.emplace_back(number, std::move(values));
   }
