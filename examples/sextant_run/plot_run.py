@@ -42,6 +42,13 @@ def ellipse(row):
                    fill=False, color="tab:blue", linewidth=0.8)
 
 
+def save(fig, path):
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
 def plot_map(directory, key, steps, landmarks, truth, unit):
     fig, ax = plt.subplots(figsize=(8, 7))
     if truth:
@@ -60,11 +67,7 @@ def plot_map(directory, key, steps, landmarks, truth, unit):
     ax.set_title(f"{directory.name}: {key} — trajectory and map")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    out = directory / f"{key}_map.png"
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
-    return out
+    return save(fig, directory / f"{key}_map.png")
 
 
 def plot_errors(directory, key, steps, unit):
@@ -82,11 +85,7 @@ def plot_errors(directory, key, steps, unit):
     bottom.set_ylabel("NEES")
     bottom.grid(True, alpha=0.3, which="both")
     bottom.legend(loc="best", fontsize=8)
-    out = directory / f"{key}_errors.png"
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
-    return out
+    return save(fig, directory / f"{key}_errors.png")
 
 
 def main():

@@ -51,4 +51,28 @@ ValueAndJacobian<Rows, N> value_and_jacobian(F f, const Eigen::Matrix<double, N,
   return out;
 }
 
+template <int Rows, int A, int B>
+struct ValueAndJacobians {
+  Eigen::Matrix<double, Rows, 1> value;
+  Eigen::Matrix<double, Rows, A> jacobian_a;  ///< df/da
+  Eigen::Matrix<double, Rows, B> jacobian_b;  ///< df/db
+};
+
+/// f(a, b) and its Jacobians with respect to a and to b (the shape of every model function: pose
+/// and control, pose and landmark, pose and measurement). f takes two Eigen vectors of one dual
+/// scalar type and returns an Eigen vector of it.
+template <int Rows, int A, int B, class F>
+ValueAndJacobians<Rows, A, B> value_and_jacobians(F f, const Eigen::Matrix<double, A, 1>& a,
+                                                  const Eigen::Matrix<double, B, 1>& b) {
+  Eigen::Matrix<double, A + B, 1> stacked;
+  stacked << a, b;
+  const auto both = value_and_jacobian<Rows>(
+      [&f](const auto& ab) {
+        using Scalar = typename std::decay_t<decltype(ab)>::Scalar;
+        return f(Eigen::Matrix<Scalar, A, 1>(ab.template head<A>()), Eigen::Matrix<Scalar, B, 1>(ab.template tail<B>()));
+      },
+      stacked);
+  return {both.value, both.jacobian.template leftCols<A>(), both.jacobian.template rightCols<B>()};
+}
+
 }  // namespace sextant

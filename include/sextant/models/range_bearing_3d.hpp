@@ -21,18 +21,16 @@ struct RangeBearing3D {
   Eigen::Matrix3d Q = Eigen::Matrix3d::Identity();  ///< covariance of (range, yaw, pitch)
 
   MeasurementPrediction<3, 6, 3> predict(const Eigen::Matrix<double, 6, 1>& x, const Landmark& m) const {
-    Eigen::Matrix<double, 9, 1> arguments;
-    arguments << x, m;
-    const auto f = value_and_jacobian<3>(
-        [this](const auto& a) {
-          using Scalar = typename std::decay_t<decltype(a)>::Scalar;
-          return spherical<Scalar>(point_in_frame<Scalar>(sensor_in_world<Scalar>(a.template head<6>()), a.template tail<3>()));
+    const auto f = value_and_jacobians<3>(
+        [this](const auto& pose, const auto& landmark) {
+          using Scalar = typename std::decay_t<decltype(pose)>::Scalar;
+          return spherical<Scalar>(point_in_frame<Scalar>(sensor_in_world<Scalar>(pose), landmark));
         },
-        arguments);
+        x, m);
     MeasurementPrediction<3, 6, 3> out;
     out.z = f.value;
-    out.J_z_x = f.jacobian.leftCols<6>();
-    out.J_z_m = f.jacobian.rightCols<3>();
+    out.J_z_x = f.jacobian_a;
+    out.J_z_m = f.jacobian_b;
     out.Q = Q;
     return out;
   }
@@ -43,23 +41,21 @@ struct RangeBearing3D {
 
   /// m = sensor (+) (r cos(p) cos(y), r cos(p) sin(y), -r sin(p)).
   LandmarkInit<3, 6, 3> initialize(const Eigen::Matrix<double, 6, 1>& x, const Measurement& z) const {
-    Eigen::Matrix<double, 9, 1> arguments;
-    arguments << x, z;
-    const auto f = value_and_jacobian<3>(
-        [this](const auto& a) {
-          using Scalar = typename std::decay_t<decltype(a)>::Scalar;
+    const auto f = value_and_jacobians<3>(
+        [this](const auto& pose, const auto& measurement) {
+          using Scalar = typename std::decay_t<decltype(pose)>::Scalar;
           using std::cos;
           using std::sin;
-          const Pose3Euler<Scalar> sensor = sensor_in_world<Scalar>(a.template head<6>());
-          const Scalar r = a(6), yaw = a(7), pitch = a(8);
+          const Pose3Euler<Scalar> sensor = sensor_in_world<Scalar>(pose);
+          const Scalar r = measurement(0), yaw = measurement(1), pitch = measurement(2);
           const Eigen::Matrix<Scalar, 3, 1> local(r * cos(pitch) * cos(yaw), r * cos(pitch) * sin(yaw), -r * sin(pitch));
           return Eigen::Matrix<Scalar, 3, 1>(sensor.template head<3>() + rotation_of(sensor) * local);
         },
-        arguments);
+        x, z);
     LandmarkInit<3, 6, 3> out;
     out.m = f.value;
-    out.J_m_x = f.jacobian.leftCols<6>();
-    out.J_m_z = f.jacobian.rightCols<3>();
+    out.J_m_x = f.jacobian_a;
+    out.J_m_z = f.jacobian_b;
     out.Q = Q;
     return out;
   }

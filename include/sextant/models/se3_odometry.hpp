@@ -29,18 +29,16 @@ struct Se3Odometry {
   static constexpr int kDim = 6;
 
   MotionPrediction<State, 6> predict(const State& x, const Control& u, double /*dt*/) const {
-    Eigen::Matrix<double, 12, 1> arguments;
-    arguments << x, u.delta;
-    const auto f = value_and_jacobian<6>(
-        [](const auto& a) {
-          using Scalar = typename std::decay_t<decltype(a)>::Scalar;
-          return compose<Scalar>(a.template head<6>(), a.template tail<6>());
+    const auto f = value_and_jacobians<6>(
+        [](const auto& pose, const auto& delta) {
+          using Scalar = typename std::decay_t<decltype(pose)>::Scalar;
+          return compose<Scalar>(pose, delta);
         },
-        arguments);
+        x, u.delta);
     MotionPrediction<State, 6> out;
     out.x = Space::plus(f.value, Vector6d::Zero());
-    out.J_x_x = f.jacobian.leftCols<6>();
-    const Matrix6d V = f.jacobian.rightCols<6>();
+    out.J_x_x = f.jacobian_a;
+    const Matrix6d& V = f.jacobian_b;
     out.R = V * u.cov * V.transpose();
     out.R = (0.5 * (out.R + out.R.transpose())).eval();
     return out;
@@ -48,19 +46,16 @@ struct Se3Odometry {
 
   /// The odometry factor: r = ((-)x_from (+) x_to) - delta, angles wrapped; cov = u.cov.
   BetweenFactor<6> between(const State& from, const State& to, const Control& u, double /*dt*/) const {
-    Eigen::Matrix<double, 12, 1> arguments;
-    arguments << from, to;
-    const auto f = value_and_jacobian<6>(
-        [&u](const auto& a) {
+    const auto f = value_and_jacobians<6>(
+        [&u](const auto& a, const auto& b) {
           using Scalar = typename std::decay_t<decltype(a)>::Scalar;
-          return euler_difference<Scalar>(relative_pose<Scalar>(a.template head<6>(), a.template tail<6>()),
-                                           u.delta.cast<Scalar>());
+          return euler_difference<Scalar>(relative_pose<Scalar>(a, b), u.delta.cast<Scalar>());
         },
-        arguments);
+        from, to);
     BetweenFactor<6> out;
     out.r = f.value;
-    out.J_from = f.jacobian.leftCols<6>();
-    out.J_to = f.jacobian.rightCols<6>();
+    out.J_from = f.jacobian_a;
+    out.J_to = f.jacobian_b;
     out.cov = u.cov;
     return out;
   }
