@@ -1,6 +1,10 @@
-// GraphSLAM's optimize() beside Ceres (SPARSE_SCHUR and SPARSE_NORMAL_CHOLESKY, SuiteSparse, one
-// thread) on the same problems from the same starting point, each solved to the same final cost
-// (reported as the chi2 counter): the 1390-step ship and cityTrees10000 (../shared/data).
+// GraphSLAM's optimize() beside Ceres on the same problems from the same starting point: the
+// 1390-step ship and cityTrees10000 (../shared/data). Each runs as its users run it: GraphSLAM with
+// its default options, Ceres with its default Solver::Options (LM, its own stopping tolerances)
+// except the linear solver (SPARSE_SCHUR or SPARSE_NORMAL_CHOLESKY) on SuiteSparse, one thread.
+// Counters: chi2 (final), iterations, and to_optimum_ms, the time at which the solver's own log
+// first shows a chi2 within 1e-6 (relative) of the optimum (computed once per problem by
+// running Ceres to the stationary point), -1 if it stops before.
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -45,9 +49,23 @@ PlanarGraph planar_graph(const io::PlanarDataset& data, GraphOptions options) {
   return graph;
 }
 
+/// The first time at which chi2 (given per iteration with its time) is within 1e-6 of the optimum.
+double time_to_optimum_ms(const std::vector<double>& chi2, const std::vector<double>& seconds, double optimum) {
+  for (std::size_t i = 0; i < chi2.size(); ++i)
+    if (chi2[i] <= optimum * (1.0 + 1e-6)) return 1e3 * seconds[i];
+  return -1.0;
+}
+
+template <int X, class Build>
+double optimum_by_ceres(Build build) {
+  test::CeresGraph<X> peer;
+  build(peer);
+  return 2.0 * peer.solve(ceres::SPARSE_NORMAL_CHOLESKY, test::CeresStopping::optimum).final_cost;
+}
+
 template <class Graph, class Make>
-void optimize_graph(benchmark::State& state, Make make) {
-  double cost = 0.0;
+void optimize_graph(benchmark::State& state, Make make, double optimum) {
+  double cost = 0.0, to_optimum = -1.0;
   int iterations = 0;
   for (auto _ : state) {
     state.PauseTiming();
@@ -57,30 +75,39 @@ void optimize_graph(benchmark::State& state, Make make) {
     state.PauseTiming();
     cost = summary.cost.back();
     iterations = summary.iterations;
+    to_optimum = time_to_optimum_ms(summary.cost, summary.seconds, optimum);
     state.ResumeTiming();
   }
   state.counters["chi2"] = cost;
   state.counters["iterations"] = iterations;
+  state.counters["to_optimum_ms"] = to_optimum;
 }
 
 template <int X, class Build>
-void solve_with_ceres(benchmark::State& state, ceres::LinearSolverType type, Build build) {
-  double cost = 0.0;
+void solve_with_ceres(benchmark::State& state, ceres::LinearSolverType type, Build build, double optimum) {
+  double cost = 0.0, to_optimum = -1.0;
   int iterations = 0;
   for (auto _ : state) {
     state.PauseTiming();
     auto peer = std::make_unique<test::CeresGraph<X>>();
     build(*peer);
     state.ResumeTiming();
-    const auto summary = peer->solve(type);
+    const auto summary = peer->solve(type, test::CeresStopping::defaults);
     state.PauseTiming();
     cost = 2.0 * summary.final_cost;  // Ceres reports chi2 / 2
-    iterations = static_cast<int>(summary.iterations.size());
+    iterations = static_cast<int>(summary.iterations.size()) - 1;  // entry 0 is the start
+    std::vector<double> chi2, seconds;
+    for (const auto& it : summary.iterations) {
+      chi2.push_back(2.0 * it.cost);
+      seconds.push_back(it.cumulative_time_in_seconds);
+    }
+    to_optimum = time_to_optimum_ms(chi2, seconds, optimum);
     peer.reset();
     state.ResumeTiming();
   }
   state.counters["chi2"] = cost;
   state.counters["iterations"] = iterations;
+  state.counters["to_optimum_ms"] = to_optimum;
 }
 
 // Ceres starts where GraphSLAM starts: dead reckoning and the inverse measurement model.
@@ -105,14 +132,27 @@ void build_city_trees_peer(test::CeresGraph<3>& peer) {
   test::build_planar(peer, kFirstPoseCov, data.initial_observations, data.steps, data.landmark_cov);
 }
 
-// The ship.
-void BM_Ship_GraphSlam(benchmark::State& state) { optimize_graph<ShipGraph>(state, [] { return ship_graph({}); }); }
-void BM_Ship_GraphSlamLandmarkSchur(benchmark::State& state) {
-  optimize_graph<ShipGraph>(state, [] { return ship_graph({.solver = GraphSolver::landmark_schur}); });
+double ship_optimum() {
+  static const double optimum = optimum_by_ceres<2>(build_ship_peer);
+  return optimum;
 }
-void BM_Ship_CeresSparseSchur(benchmark::State& state) { solve_with_ceres<2>(state, ceres::SPARSE_SCHUR, build_ship_peer); }
+double city_trees_optimum() {
+  static const double optimum = optimum_by_ceres<3>(build_city_trees_peer);
+  return optimum;
+}
+
+// The ship.
+void BM_Ship_GraphSlam(benchmark::State& state) {
+  optimize_graph<ShipGraph>(state, [] { return ship_graph({}); }, ship_optimum());
+}
+void BM_Ship_GraphSlamLandmarkSchur(benchmark::State& state) {
+  optimize_graph<ShipGraph>(state, [] { return ship_graph({.solver = GraphSolver::landmark_schur}); }, ship_optimum());
+}
+void BM_Ship_CeresSparseSchur(benchmark::State& state) {
+  solve_with_ceres<2>(state, ceres::SPARSE_SCHUR, build_ship_peer, ship_optimum());
+}
 void BM_Ship_CeresSparseNormalCholesky(benchmark::State& state) {
-  solve_with_ceres<2>(state, ceres::SPARSE_NORMAL_CHOLESKY, build_ship_peer);
+  solve_with_ceres<2>(state, ceres::SPARSE_NORMAL_CHOLESKY, build_ship_peer, ship_optimum());
 }
 
 // cityTrees10000.
@@ -124,17 +164,38 @@ bool require_city_trees(benchmark::State& state) {
   return false;
 }
 void BM_CityTrees_GraphSlam(benchmark::State& state) {
-  if (require_city_trees(state)) optimize_graph<PlanarGraph>(state, [] { return planar_graph(*city_trees(), {}); });
+  if (require_city_trees(state))
+    optimize_graph<PlanarGraph>(state, [] { return planar_graph(*city_trees(), {}); }, city_trees_optimum());
 }
 void BM_CityTrees_GraphSlamLandmarkSchur(benchmark::State& state) {
   if (require_city_trees(state))
-    optimize_graph<PlanarGraph>(state, [] { return planar_graph(*city_trees(), {.solver = GraphSolver::landmark_schur}); });
+    optimize_graph<PlanarGraph>(
+        state, [] { return planar_graph(*city_trees(), {.solver = GraphSolver::landmark_schur}); }, city_trees_optimum());
 }
 void BM_CityTrees_CeresSparseSchur(benchmark::State& state) {
-  if (require_city_trees(state)) solve_with_ceres<3>(state, ceres::SPARSE_SCHUR, build_city_trees_peer);
+  if (require_city_trees(state))
+    solve_with_ceres<3>(state, ceres::SPARSE_SCHUR, build_city_trees_peer, city_trees_optimum());
 }
 void BM_CityTrees_CeresSparseNormalCholesky(benchmark::State& state) {
-  if (require_city_trees(state)) solve_with_ceres<3>(state, ceres::SPARSE_NORMAL_CHOLESKY, build_city_trees_peer);
+  if (require_city_trees(state))
+    solve_with_ceres<3>(state, ceres::SPARSE_NORMAL_CHOLESKY, build_city_trees_peer, city_trees_optimum());
+}
+
+/// A GraphSLAM run that asks for pose() after every step (what eval::run does): total time for
+/// K steps must grow linearly in K (pose() is O(1); docs/benchmarks.md).
+void BM_GraphSlamRunWithPoseEveryStep(benchmark::State& state) {
+  const auto steps = static_cast<std::size_t>(state.range(0));
+  sim::Ship2DOptions options;
+  options.seed = 1;
+  options.num_steps = static_cast<int>(steps);
+  const auto data = sim::simulate_ship_2d(options);
+  for (auto _ : state) {
+    ShipGraph graph{data.motion, data.sensor, data.prior};
+    benchmark::DoNotOptimize(eval::run(graph, data.steps));
+  }
+  state.counters["steps"] = static_cast<double>(steps);
+  state.counters["us_per_step"] = benchmark::Counter(static_cast<double>(steps), benchmark::Counter::kIsIterationInvariantRate |
+                                                                                     benchmark::Counter::kInvert);
 }
 
 }  // namespace
@@ -147,4 +208,5 @@ BENCHMARK(BM_CityTrees_GraphSlam)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CityTrees_GraphSlamLandmarkSchur)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CityTrees_CeresSparseSchur)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CityTrees_CeresSparseNormalCholesky)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GraphSlamRunWithPoseEveryStep)->Arg(1000)->Arg(2000)->Arg(4000)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -1,6 +1,8 @@
 // SEIF-SLAM time per step against map size with max_active fixed, beside EKF-SLAM, in one run; and the
 // heap memory each holds per landmark (measured with glibc's mallinfo2 around the construction).
-// The ship drives around a circle of beacons, seeing the 4 nearest at every step.
+// The ship drives around a circle of beacons, seeing the 4 nearest at every step. The *WithPose rows
+// add the pose() (mean and marginal covariance) an evaluation reads after every step: O(1) for the
+// EKF, a sparse Cholesky factorization of Omega for SEIF.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -40,7 +42,7 @@ Ekf ekf_with_map(const CircleWorld& world) {
   return ekf;
 }
 
-template <class Backend, class Build>
+template <class Backend, bool kReadPose, class Build>
 void run_steps(benchmark::State& state, Build build) {
   const CircleWorld world(static_cast<int>(state.range(0)));
   const std::size_t heap_before = heap_in_use();
@@ -51,13 +53,16 @@ void run_steps(benchmark::State& state, Build build) {
     ++step;
     backend.predict(world.control(step), 1.0);
     benchmark::DoNotOptimize(backend.update(world.observations(step)));
+    if constexpr (kReadPose) benchmark::DoNotOptimize(backend.pose());
   }
   state.counters["landmarks"] = world.count;
   state.counters["bytes_per_landmark"] = bytes / world.count;
 }
 
-void BM_SeifStep(benchmark::State& state) { run_steps<Seif>(state, seif_after_one_lap); }
-void BM_EkfStep(benchmark::State& state) { run_steps<Ekf>(state, ekf_with_map); }
+void BM_SeifStep(benchmark::State& state) { run_steps<Seif, false>(state, seif_after_one_lap); }
+void BM_EkfStep(benchmark::State& state) { run_steps<Ekf, false>(state, ekf_with_map); }
+void BM_SeifStepWithPose(benchmark::State& state) { run_steps<Seif, true>(state, seif_after_one_lap); }
+void BM_EkfStepWithPose(benchmark::State& state) { run_steps<Ekf, true>(state, ekf_with_map); }
 
 void map_sizes(benchmark::internal::Benchmark* b) {
   for (int landmarks : {100, 300, 1000, 3000, 10000}) b->Arg(landmarks);
@@ -68,4 +73,6 @@ void map_sizes(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(BM_SeifStep)->Apply(map_sizes);
 BENCHMARK(BM_EkfStep)->Apply(map_sizes);
+BENCHMARK(BM_SeifStepWithPose)->Apply(map_sizes);
+BENCHMARK(BM_EkfStepWithPose)->Apply(map_sizes);
 BENCHMARK_MAIN();

@@ -10,46 +10,9 @@
 
 #include "progress_bar.hpp"
 #include "runner_config.hpp"
+#include "table.hpp"
 
 namespace sextant::runner {
-
-enum class BackendKind { ekf, seif, graph, fastslam1, fastslam2 };
-
-inline const std::vector<BackendKind>& all_backends() {
-  static const std::vector<BackendKind> all = {BackendKind::ekf, BackendKind::seif, BackendKind::graph,
-                                               BackendKind::fastslam1, BackendKind::fastslam2};
-  return all;
-}
-
-/// The command-line name of a back-end (also the prefix of its output files).
-inline std::string backend_key(BackendKind kind) {
-  switch (kind) {
-    case BackendKind::ekf: return "ekf";
-    case BackendKind::seif: return "seif";
-    case BackendKind::graph: return "graph";
-    case BackendKind::fastslam1: return "fastslam1";
-    case BackendKind::fastslam2: return "fastslam2";
-  }
-  return "?";
-}
-
-/// The table's name of a back-end with its main setting.
-inline std::string backend_label(BackendKind kind, const RunnerConfig& c) {
-  switch (kind) {
-    case BackendKind::ekf: return "EKF-SLAM";
-    case BackendKind::seif:
-      return c.seif.max_active ? "SEIF-SLAM, " + std::to_string(c.seif.max_active) + " active" : "SEIF-SLAM, all active";
-    case BackendKind::graph: return "GraphSLAM";
-    case BackendKind::fastslam1: return "FastSLAM 1.0, " + std::to_string(c.fastslam.particles) + " particles";
-    case BackendKind::fastslam2: return "FastSLAM 2.0, " + std::to_string(c.fastslam.particles) + " particles";
-  }
-  return "?";
-}
-
-/// How a data set is scored: which pose entries are position, the degrees of freedom for NEES.
-struct Scoring {
-  int position_dim, pose_dof, landmark_dof;
-};
 
 /// One back-end's run: its scores and what the output files and scene need.
 template <class Dataset>
@@ -101,13 +64,6 @@ BackendRun<Dataset> run_backend(BackendKind kind, const Dataset& data, const Run
   }
   return out;
 }
-
-/// A line of the comparison table.
-struct TableRow {
-  std::string dataset, backend, label;
-  eval::Summary summary;
-  int runs = 1;
-};
 
 /// Every chosen back-end on one rawlog: one run each; `first_runs` receives them for the outputs.
 template <class Dataset>

@@ -5,14 +5,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <sextant/backends/ekf_slam.hpp>
 #include <string>
 #include <variant>
 #include <vector>
 
-#include "experiments.hpp"
-#include "run_outputs.hpp"
+#include "dataset_runs.hpp"
 #include "runner_config.hpp"
+#include "table.hpp"
 
 namespace {
 
@@ -26,9 +25,9 @@ const std::vector<std::string> kMrptDemos = {"kf-slam_demo.rawlog", "kf-slam_6D_
 struct Options {
   std::vector<std::string> backends{"all"};
   std::vector<std::string> datasets;
-  std::string config, out;
+  std::string config;
   int runs = 0;
-  bool plots = false;
+  RunOptions output;
 };
 
 std::vector<BackendKind> parse_backends(const std::vector<std::string>& names) {
@@ -61,68 +60,6 @@ std::vector<std::string> expand_datasets(const std::vector<std::string>& request
   return out;
 }
 
-void print_header() {
-  std::printf("%-29s %11s %11s %14s %13s %11s %10s %13s\n", "back-end", "pose MAE", "map MAE", "pose NEES in", "map NEES in",
-              "pose ANEES", "total [s]", "per step[us]");
-}
-
-void print_row(const TableRow& row) {
-  const auto& s = row.summary;
-  std::printf("%-29s %11.4g %11.4g %13.1f%% %12.1f%% %11.4g %10.4f %13.1f\n", row.label.c_str(), s.pose_mae, s.map_mae,
-              100.0 * s.pose_nees_inside, 100.0 * s.map_nees_inside, s.pose_anees, s.total_seconds,
-              1e6 * s.seconds_per_step);
-}
-
-std::string directory_name(const std::string& dataset) {
-  return dataset == "ship" ? "ship" : std::filesystem::path(dataset).stem().string();
-}
-
-/// Writes the files of every run of one data set and, if asked, the plots.
-template <class Dataset>
-void write_dataset_outputs(const Options& options, const std::string& dataset, const Dataset& data,
-                           const std::vector<std::pair<BackendKind, BackendRun<Dataset>>>& runs, const Scoring& scoring,
-                           const RunnerConfig& config, const char* unit) {
-  if (options.out.empty()) return;
-  const auto dir = std::filesystem::path(options.out) / directory_name(dataset);
-  for (const auto& [kind, run] : runs) write_run_outputs(dir, kind, run, data, scoring, config);
-  std::printf("wrote per-step CSV, map CSV, TUM trajectories and .3Dscene files to %s\n", dir.c_str());
-  if (!options.plots) return;
-  const auto script = std::filesystem::canonical("/proc/self/exe").parent_path() / "plot_run.py";
-  // Debian's interpreter (where python3-matplotlib installs) before whatever python3 is first on PATH.
-  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string command = python + " '" + script.string() + "' '" + dir.string() + "' " + unit;
-  if (std::system(command.c_str()) != 0)
-    throw error(dir.string() + ": plotting failed (needs python3 with matplotlib: Debian python3-matplotlib)");
-  std::printf("wrote plots (PNG) to %s\n", dir.c_str());
-}
-
-/// Runs the chosen back-ends on one data set, prints its part of the table, writes its outputs.
-template <class Dataset>
-std::vector<TableRow> run_dataset(const Options& options, const std::string& name, const Dataset& data,
-                                  const std::vector<BackendKind>& kinds, const RunnerConfig& config,
-                                  const Scoring& scoring, const char* unit) {
-  std::printf("\n== %s: %zu steps, %zu landmarks in the ground truth; errors in %s\n", name.c_str(), data.steps.size(),
-              data.true_landmarks.size(), unit);
-  print_header();
-  std::vector<std::pair<BackendKind, BackendRun<Dataset>>> runs;
-  auto rows = run_on_rawlog(name, data, kinds, config, scoring, runs);
-  for (const auto& row : rows) print_row(row);
-  write_dataset_outputs(options, name, data, runs, scoring, config, unit);
-  return rows;
-}
-
-std::vector<TableRow> run_ship(const Options& options, const std::vector<BackendKind>& kinds, const RunnerConfig& config) {
-  const Scoring scoring{2, 2, 2};
-  std::printf("\n== ship: the thesis's 2D beacon ship, %d steps, %d Monte Carlo run(s) from seed %llu; errors in km\n",
-              config.ship.num_steps, config.ship_runs, static_cast<unsigned long long>(config.ship.seed));
-  print_header();
-  std::vector<std::pair<BackendKind, BackendRun<sim::Ship2DDataset>>> runs;
-  auto rows = run_on_ship(kinds, config, scoring, runs);
-  for (const auto& row : rows) print_row(row);
-  write_dataset_outputs(options, "ship", sim::simulate_ship_2d(config.ship), runs, scoring, config, "km");
-  return rows;
-}
-
 /// The ground-truth files beside a rawlog, which sextant-run needs to score the runs.
 mrpt_io::GroundTruthFiles require_ground_truth(const std::string& path) {
   const auto truth = mrpt_io::find_ground_truth(path);
@@ -140,8 +77,7 @@ std::vector<TableRow> run_rawlog(const Options& options, const std::string& path
   return std::visit(
       [&](auto& data) {
         mrpt_io::attach_ground_truth(data, require_ground_truth(path));
-        constexpr bool planar = std::decay_t<decltype(data)>::Motion::kDim == 3;
-        return run_dataset(options, name, data, kinds, config, planar ? Scoring{2, 3, 2} : Scoring{3, 6, 3}, "m");
+        return run_rawlog_dataset(options.output, name, data, kinds, config);
       },
       dataset);
 }
@@ -164,9 +100,9 @@ int main(int argc, char** argv) {
                  "ship | mrpt-demos | <file.rawlog> (repeatable; default: ship and the MRPT kf-slam demos)");
   app.add_option("--config,-c", options.config, "ini file (MRPT CConfigFile) with [ship] [rawlog] [ekf] [seif] [graph] "
                                                 "[fastslam] [scene] keys; see --print-config");
-  app.add_option("--out,-o", options.out, "directory for per-step CSV, TUM, .3Dscene files and summary.json");
+  app.add_option("--out,-o", options.output.out, "directory for per-step CSV, TUM, .3Dscene files and summary.json");
   app.add_option("--runs", options.runs, "Monte Carlo runs on the ship (overrides [ship] runs)")->check(CLI::Range(1, 100000));
-  app.add_flag("--plots", options.plots, "also write PNG plots of trajectory, map, error and NEES (needs --out or "
+  app.add_flag("--plots", options.output.plots, "also write PNG plots of trajectory, map, error and NEES (needs --out or "
                                          "writes to ./sextant-run-output)");
   app.add_flag("--print-config", print_config, "print every config key with its default and meaning, then exit");
   CLI11_PARSE(app, argc, argv);
@@ -178,18 +114,19 @@ int main(int argc, char** argv) {
   try {
     RunnerConfig config = load_config(options.config);
     if (options.runs > 0) config.ship_runs = options.runs;
-    if (options.plots && options.out.empty()) options.out = "sextant-run-output";
+    if (options.output.plots && options.output.out.empty()) options.output.out = "sextant-run-output";
     const auto kinds = parse_backends(options.backends);
     std::vector<TableRow> rows;
     for (const auto& dataset : expand_datasets(options.datasets)) {
-      auto part = dataset == "ship" ? run_ship(options, kinds, config) : run_rawlog(options, dataset, kinds, config);
+      auto part = dataset == "ship" ? run_ship(options.output, kinds, config) : run_rawlog(options, dataset, kinds, config);
       rows.insert(rows.end(), part.begin(), part.end());
     }
-    std::printf("\nNEES in: share of steps (pose) or landmarks (map) whose NEES is inside the 95%% chi-square bound; "
+    std::printf("\naligned: the same error after the best rigid alignment of the trajectory (map) to the truth; "
+                "NEES in: share of steps (pose) or landmarks (map) whose NEES is inside the 95%% chi-square bound; "
                 "pose ANEES: mean NEES over steps and runs (pose dof: ship 2, planar 3, 6D 6).\n");
-    if (!options.out.empty()) {
-      std::filesystem::create_directories(options.out);
-      const auto json = (std::filesystem::path(options.out) / "summary.json").string();
+    if (!options.output.out.empty()) {
+      std::filesystem::create_directories(options.output.out);
+      const auto json = (std::filesystem::path(options.output.out) / "summary.json").string();
       write_summary_json(json, rows);
       std::printf("wrote %s\n", json.c_str());
     }

@@ -93,28 +93,4 @@ void write_run_outputs(const std::filesystem::path& dir, BackendKind kind, const
 }
 
 /// A JSON number, or null when not finite (JSON has no NaN or Inf).
-inline std::string json_number(double x) {
-  if (!std::isfinite(x)) return "null";
-  std::ostringstream out;
-  out << std::setprecision(10) << x;
-  return out.str();
-}
-
-/// The table as JSON: one object per row.
-inline void write_summary_json(const std::string& path, const std::vector<TableRow>& rows) {
-  std::ofstream out(path);
-  if (!out) throw error("cannot open " + path + " for writing");
-  out << std::setprecision(10) << "[\n";
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const auto& s = rows[i].summary;
-    out << "  {\"dataset\": \"" << rows[i].dataset << "\", \"backend\": \"" << rows[i].backend << "\", \"label\": \""
-        << rows[i].label << "\", \"runs\": " << rows[i].runs << ", \"pose_mae\": " << json_number(s.pose_mae)
-        << ", \"map_mae\": " << json_number(s.map_mae) << ", \"pose_nees_inside\": " << json_number(s.pose_nees_inside)
-        << ", \"map_nees_inside\": " << json_number(s.map_nees_inside) << ", \"pose_anees\": " << json_number(s.pose_anees)
-        << ", \"total_seconds\": " << json_number(s.total_seconds)
-        << ", \"seconds_per_step\": " << json_number(s.seconds_per_step) << "}" << (i + 1 < rows.size() ? ",\n" : "\n");
-  }
-  out << "]\n";
-}
-
 }  // namespace sextant::runner

@@ -31,7 +31,7 @@ struct RunnerConfig {
   EkfOptions ekf;
   SeifOptions seif{.max_active = 8};
   GraphOptions graph;
-  FastSlamOptions fastslam;
+  FastSlamOptions fastslam{.particles = 100, .resample_threshold = 0.1, .map_estimate = FastSlamMap::weighted_average};
   double scene_quantile = 3.0;
 };
 
@@ -163,15 +163,15 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.graph.levenberg_marquardt = parse_bool(v); }},
       {"graph", "window", "0", "windowed initialization: optimize growing parts of this many steps first; 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.graph.window = static_cast<std::size_t>(parse_integer(v, 0)); }},
-      {"fastslam", "particles", "50", "particles",
+      {"fastslam", "particles", "100", "particles",
        [](RunnerConfig& c, const std::string& v) { c.fastslam.particles = static_cast<std::size_t>(parse_integer(v, 1)); }},
-      {"fastslam", "resample_threshold", "0.5", "resample when N_eff < threshold * particles (1 = always, 0 = never)",
+      {"fastslam", "resample_threshold", "0.1", "resample when N_eff < threshold * particles (1 = always, 0 = never)",
        [](RunnerConfig& c, const std::string& v) {
          const double t = parse_number(v);
          if (t < 0.0 || t > 1.0) throw invalid_input_error("'" + v + "' must be in [0, 1]");
          c.fastslam.resample_threshold = t;
        }},
-      {"fastslam", "map_estimate", "best_particle", "best_particle | weighted_average (moment-matched over particles)",
+      {"fastslam", "map_estimate", "weighted_average", "best_particle | weighted_average (moment-matched over particles)",
        [](RunnerConfig& c, const std::string& v) {
          c.fastslam.map_estimate =
              parse_choice<FastSlamMap>(v, {{"best_particle", FastSlamMap::best_particle}, {"weighted_average", FastSlamMap::weighted_average}});

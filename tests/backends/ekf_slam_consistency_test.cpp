@@ -29,25 +29,33 @@ std::vector<double> pose_nees_of_run(std::uint64_t seed, HeadingNoise heading_no
 
 struct Consistency {
   double anees;               // mean over runs and steps
-  double fraction_of_steps;   // steps whose ANEES over runs lies inside the interval
-  eval::Interval interval;
+  eval::Interval interval;    // of that mean (time_averaged_anees_interval)
+  double fraction_of_steps;   // steps whose ANEES over the runs lies inside that step's interval
+  eval::Interval step_interval;  // chi2(2 N) / N: one step's average over N independent runs
 };
 
-Consistency pose_consistency(HeadingNoise heading_noise) {
-  const auto runs = eval::monte_carlo(kRuns, 1000, [&](std::uint64_t seed) { return pose_nees_of_run(seed, heading_noise); });
+Consistency pose_consistency(HeadingNoise heading_noise, int runs_count = kRuns, std::uint64_t first_seed = 1000) {
+  const auto runs =
+      eval::monte_carlo(runs_count, first_seed, [&](std::uint64_t seed) { return pose_nees_of_run(seed, heading_noise); });
+  std::vector<double> per_run;
+  for (const auto& run : runs) per_run.push_back(eval::mean(run));
   const auto per_step = eval::anees_per_step(runs);
-  const auto interval = eval::anees_interval(2, kRuns);
+  const auto step_interval = eval::anees_interval(2, runs_count);
   const double inside = static_cast<double>(std::count_if(per_step.begin(), per_step.end(),
-                                                          [&](double a) { return interval.contains(a); }));
-  return {eval::mean(per_step), inside / static_cast<double>(per_step.size()), interval};
+                                                          [&](double a) { return step_interval.contains(a); }));
+  return {eval::mean(per_run), eval::time_averaged_anees_interval(2, per_run), inside / static_cast<double>(per_step.size()),
+          step_interval};
 }
 
 TEST(EkfSlamConsistency, ShipPoseAneesInsideItsInterval) {
   const auto c = pose_consistency(HeadingNoise::unbiased);
-  std::printf("pose ANEES %.3f over %d runs, 95%% interval [%.3f, %.3f], steps inside %.1f%%\n", c.anees, kRuns,
-              c.interval.lower, c.interval.upper, 100.0 * c.fraction_of_steps);
+  std::printf("pose ANEES %.3f over %d runs and all steps, 95%% interval [%.3f, %.3f]; steps inside [%.3f, %.3f]: %.1f%%\n",
+              c.anees, kRuns, c.interval.lower, c.interval.upper, c.step_interval.lower, c.step_interval.upper,
+              100.0 * c.fraction_of_steps);
   EXPECT_TRUE(c.interval.contains(c.anees)) << c.anees;
-  EXPECT_GE(c.fraction_of_steps, 0.90);  // 95% expected for a consistent filter
+  // 95% of the steps for a consistent filter; the steps are correlated (an excursion lasts several
+  // steps), so the share scatters more than a binomial one: 0.90 is that margin.
+  EXPECT_GE(c.fraction_of_steps, 0.90);
 }
 
 TEST(EkfSlamConsistency, ThesisLinearizedHeadingNoiseIsOverconfident) {
@@ -56,6 +64,7 @@ TEST(EkfSlamConsistency, ThesisLinearizedHeadingNoiseIsOverconfident) {
   const auto c = pose_consistency(HeadingNoise::linearized);
   std::printf("linearized heading noise: pose ANEES %.3f\n", c.anees);
   EXPECT_GT(c.anees, c.interval.upper);
+  EXPECT_GT(c.anees, c.step_interval.upper);
 }
 
 }  // namespace

@@ -6,7 +6,9 @@
 #include "sextant/models/beacon_ship_2d.hpp"
 #include "sextant/sim/ship_2d.hpp"
 #include "sextant/testing/textbook_ekf.hpp"
+#include "sextant/eval/metrics.hpp"
 #include "support/batch_least_squares.hpp"
+#include "support/nees_bound.hpp"
 
 namespace sextant {
 namespace {
@@ -118,8 +120,13 @@ TEST(EkfSlam, ShipRunTracksTheTruth) {
   const auto record = eval::run(ekf, data.steps);
   ASSERT_EQ(record.steps.size(), 1390u);
   EXPECT_EQ(ekf.num_landmarks(), data.true_landmarks.size());
-  EXPECT_LT((record.steps.back().pose.mean - data.true_poses.back()).norm(), 10.0);
-  for (const auto& landmark : ekf.map()) EXPECT_LT((landmark.mean - data.true_landmarks.at(landmark.id)).norm(), 50.0);
+  // A consistent estimate: final pose and every landmark inside their chi-square bounds (1% overall).
+  const auto pose = record.steps.back().pose;
+  EXPECT_LT(eval::nees(pose.mean - data.true_poses.back(), pose.cov), test::nees_bound(2));
+  const auto map = ekf.map();
+  for (const auto& landmark : map)
+    EXPECT_LT(eval::nees(landmark.mean - data.true_landmarks.at(landmark.id), landmark.cov), test::nees_bound(2, map.size()))
+        << landmark.id;
 }
 
 }  // namespace

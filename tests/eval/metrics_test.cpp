@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
 namespace sextant::eval {
 namespace {
 
@@ -53,6 +55,40 @@ TEST(Metrics, EvaluateMapPerLandmark) {
   EXPECT_EQ(evaluation.nees, (std::vector<double>{25.0, 1.0}));
   EXPECT_THROW(evaluate_map(map, std::map<LandmarkId, Eigen::Vector2d>{{4, Eigen::Vector2d::Zero()}}),
                unknown_landmark_error);
+}
+
+/// N runs of K steps of a consistent estimator whose errors are correlated in time: e_k = rho
+/// e_{k-1} + sqrt(1 - rho^2) w_k, stationary N(0, I_2), so every NEES = |e_k|^2 ~ chi2(2).
+std::vector<double> correlated_run_averages(std::mt19937_64& rng, int runs, int steps, double rho) {
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::vector<double> out;
+  for (int i = 0; i < runs; ++i) {
+    Eigen::Vector2d e(unit(rng), unit(rng));
+    double sum = 0.0;
+    for (int k = 0; k < steps; ++k) {
+      e = rho * e + std::sqrt(1.0 - rho * rho) * Eigen::Vector2d(unit(rng), unit(rng));
+      sum += e.squaredNorm();
+    }
+    out.push_back(sum / steps);
+  }
+  return out;
+}
+
+TEST(Metrics, TimeAveragedAneesIntervalCoversAConsistentEstimatorWithCorrelatedSteps) {
+  constexpr int kTrials = 400, kRuns = 20, kSteps = 100;
+  std::mt19937_64 rng(11);
+  int covered = 0, covered_by_independent_steps_interval = 0;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    const auto averages = correlated_run_averages(rng, kRuns, kSteps, 0.9);
+    const double anees = mean(averages);
+    covered += time_averaged_anees_interval(2, averages).contains(anees);
+    covered_by_independent_steps_interval += anees_interval(2, kRuns * kSteps).contains(anees);
+  }
+  // Coverage 0.95 (t interval, exact up to the CLT for 20 runs): 380 of 400, binomial sd 4.4; 4 sd.
+  EXPECT_NEAR(covered, 0.95 * kTrials, 4 * std::sqrt(kTrials * 0.95 * 0.05));
+  // Treating the 2000 correlated steps as independent gives an interval far too narrow.
+  EXPECT_LT(covered_by_independent_steps_interval, 0.7 * kTrials);
+  EXPECT_THROW(time_averaged_anees_interval(2, std::vector<double>{2.0}), invalid_input_error);
 }
 
 }  // namespace

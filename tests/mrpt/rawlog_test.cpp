@@ -9,6 +9,10 @@
 #include <numbers>
 
 #include "mrpt/mrpt_demo_data.hpp"
+#include "support/nees_bound.hpp"
+#ifdef SEXTANT_HAS_MRPT_SLAM
+#include "support/mrpt_kf_slam.hpp"
+#endif
 #include "sextant/backends/ekf_slam.hpp"
 #include "sextant/backends/fast_slam.hpp"
 #include "sextant/backends/graph_slam.hpp"
@@ -51,20 +55,30 @@ TEST(KfSlamDemo, ReadsStepsSensorAndGroundTruth) {
   EXPECT_LT(worst_normalized_residual_at_truth(data, data.steps.size()), 5.0);
 }
 
+#ifdef SEXTANT_HAS_MRPT_SLAM  // CMake reports mrpt-slam missing (and run.sh fails the build)
 TEST(KfSlamDemo, EkfMapErrorIsAtMostMrptKfSlamWithTheSameNoise) {
   SEXTANT_REQUIRE_MRPT_DEMO("kf-slam_demo.rawlog");
-  // MRPT's kf-slam app with its EKF-SLAM_test_2d.ini (range 0.03 m, bearing 0.1 deg) reports a mean
-  // map error of 0.003680 m on this log (MRPT 2.5.8, measured; docs/results/mrpt_comparison.md).
+  // The peer, run here: MRPT's CRangeBearingKFSLAM2D as its kf-slam app runs it with
+  // EKF-SLAM_test_2d.ini (range 0.03 m, bearing 0.1 deg).
+  const std::string path = testing::mrpt_demo("kf-slam_demo.rawlog");
+  const auto truth_files = find_ground_truth(path);
+  ASSERT_TRUE(truth_files);
   RawlogOptions options;
   options.std_range = 0.03;
   options.std_yaw = 0.1 * kDeg;
-  auto data = read_rawlog_2d(testing::mrpt_demo("kf-slam_demo.rawlog"), options);
-  attach_ground_truth(data, *find_ground_truth(data.path));
+  auto data = read_rawlog_2d(path, options);
+  attach_ground_truth(data, *truth_files);
+  const double mrpt_error =
+      test::mean_map_error(data.true_landmarks, test::run_mrpt_kf_slam_2d(test::read_mrpt_pairs(path), 0.03, 0.1 * kDeg));
   EkfSlam<Se2Odometry, RangeBearing2D> ekf(data.motion, data.sensor, data.prior);
   const auto run = eval::evaluate_run(ekf, data, 2);
   EXPECT_EQ(run.map_error.size(), 70u);
-  EXPECT_LE(eval::mean(run.map_error), 0.003680);
+  std::printf("mean map error: sextant EKF %.4f mm, MRPT kf-slam %.4f mm\n", 1e3 * eval::mean(run.map_error),
+              1e3 * mrpt_error);
+  EXPECT_GT(mrpt_error, 0.0);
+  EXPECT_LE(eval::mean(run.map_error), mrpt_error);
 }
+#endif
 
 TEST(KfSlam6dDemos, SensorModelReproducesTheMeasurementsFromGroundTruth) {
   for (const char* name : {"kf-slam_6D_demo.rawlog", "kf-slam_6D_demo_noncentered.rawlog"}) {
@@ -84,17 +98,24 @@ TEST(KfSlam6dDemos, EveryBackEndMapsTheSpatialDemo) {
   attach_ground_truth(data, *find_ground_truth(data.path));
   using Motion = Se3Odometry;
   using Sensor = RangeBearing3D;
-  // Sanity bounds, an order of magnitude above what each reaches (docs/results/mrpt_comparison.md).
+  // The EKF against theory: every landmark inside its chi-square bound (1% overall). The others
+  // against the EKF, run here: SEIF and GraphSLAM within 2x of its map error (GraphSLAM is the
+  // smoother, SEIF the sparsified filter: neither should lose more); FastSLAM, with sextant-run's
+  // settings, within 4x of its map error after rigid alignment (its unaligned error is dominated by
+  // the gauge; on this log 8 seeds ranged 1.4x-3.5x: docs/results/fastslam_gap.md).
   EkfSlam<Motion, Sensor> ekf(data.motion, data.sensor, data.prior);
-  EXPECT_LT(eval::mean(eval::evaluate_run(ekf, data, 3).map_error), 0.05);
+  const auto ekf_run = eval::evaluate_run(ekf, data, 3);
+  for (double nees : ekf_run.map_nees) EXPECT_LT(nees, test::nees_bound(3, ekf_run.map_nees.size()));
+  const double ekf_error = eval::mean(ekf_run.map_error);
   SeifSlam<Motion, Sensor> seif(data.motion, data.sensor, data.prior, {.max_active = 8});
-  EXPECT_LT(eval::mean(eval::evaluate_run(seif, data, 3).map_error), 0.05);
+  EXPECT_LT(eval::mean(eval::evaluate_run(seif, data, 3).map_error), 2.0 * ekf_error);
   GraphSlam<Motion, Sensor> graph(data.motion, data.sensor, data.prior);
-  EXPECT_LT(eval::mean(eval::evaluate_smoothed_run(graph, data, 3).map_error), 0.05);
-  FastSlam<Motion, Sensor> fast(data.motion, data.sensor, data.prior, {.particles = 20});
+  EXPECT_LT(eval::mean(eval::evaluate_smoothed_run(graph, data, 3).map_error), 2.0 * ekf_error);
+  FastSlam<Motion, Sensor> fast(data.motion, data.sensor, data.prior,
+                                {.particles = 100, .resample_threshold = 0.1, .map_estimate = FastSlamMap::weighted_average});
   const auto fast_run = eval::evaluate_run(fast, data, 3);
   EXPECT_EQ(fast_run.map_error.size(), ekf.map().size());
-  EXPECT_LT(eval::mean(fast_run.map_error), 1.0);
+  EXPECT_LT(eval::mean(fast_run.map_error_aligned), 4.0 * eval::mean(ekf_run.map_error_aligned));
 }
 
 // ---- Logs written here with MRPT's own serialization --------------------------------------------

@@ -97,7 +97,7 @@ TEST_F(RunnerCli, PlanarRunWritesTableCsvTumJsonAndALoadableScene) {
   ASSERT_TRUE(scene.loadFromFile((out / "kf-slam_demo" / "fastslam2.3Dscene").string()));
   const auto particles = std::dynamic_pointer_cast<mrpt::opengl::CPointCloud>(scene.getByName(sextant::mrpt_io::scene_names::particles));
   ASSERT_TRUE(particles);
-  EXPECT_EQ(particles->size(), 50u);
+  EXPECT_EQ(particles->size(), 100u);  // the default [fastslam] particles
 }
 
 TEST_F(RunnerCli, SpatialRunDrawsLandmarkEllipsoids) {
@@ -166,6 +166,36 @@ TEST_F(RunnerCli, ConfigReferenceInDocsIsThePrintedDefaults) {
   text << docs.rdbuf();
   EXPECT_NE(text.str().find("```ini\n" + r.out + "```"), std::string::npos)
       << "docs/runner.md must hold the output of sextant-run --print-config in an ini block";
+}
+
+/// The README's results table is what the main job prints: its header line (the first line of the
+/// README that starts with "back-end") equals the header sextant-run prints, and every back-end and
+/// data set the README's table names is one the program prints.
+TEST_F(RunnerCli, ReadmeTableIsTheProgramsOutput) {
+  const auto r = run_runner("--dataset ship --runs 2", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto first_line_starting_with = [](std::istream& in, const std::string& prefix) {
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind(prefix, 0) == 0) return line;
+    return std::string();
+  };
+  std::istringstream printed(r.out);
+  const std::string program_header = first_line_starting_with(printed, "back-end");
+  ASSERT_FALSE(program_header.empty()) << r.out;
+  std::ifstream readme(SEXTANT_README);
+  ASSERT_TRUE(readme) << SEXTANT_README;
+  std::stringstream all;
+  all << readme.rdbuf();
+  std::istringstream readme_lines(all.str());
+  EXPECT_EQ(first_line_starting_with(readme_lines, "back-end"), program_header);
+  for (const std::string& label : {"EKF-SLAM", "SEIF-SLAM, 8 active", "GraphSLAM", "FastSLAM 1.0, 100 particles",
+                                   "FastSLAM 2.0, 100 particles"}) {
+    EXPECT_NE(r.out.find(label), std::string::npos) << label << " not printed";
+    EXPECT_NE(all.str().find(label), std::string::npos) << label << " not in the README";
+  }
+  for (const std::string& dataset : {"== ship", "== kf-slam_demo.rawlog", "== kf-slam_6D_demo.rawlog",
+                                     "== kf-slam_6D_demo_noncentered.rawlog"})
+    EXPECT_NE(all.str().find(dataset), std::string::npos) << dataset << " not in the README";
 }
 
 TEST_F(RunnerCli, IniValuesReachTheBackEnds) {

@@ -18,9 +18,13 @@ namespace sextant {
 
 /// How the covariance is corrected after a measurement update.
 enum class CovarianceUpdate {
-  /// P <- P - C S^-1 C^T with C = P H^T, as a symmetric rank update (thesis eq. 17).
+  /// P <- P - C S^-1 C^T with C = P H^T, as a symmetric rank update of the lower triangle
+  /// (thesis eq. 17): O(n^2 k / 2). Loses positive semi-definiteness when the measurements are
+  /// far more accurate than the state (docs/ekf_covariance_update.md).
   symmetric,
-  /// Joseph form (I - K H) P (I - K H)^T + K Q K^T, kept block-sparse in H.
+  /// Joseph form P <- (I - K H) P (I - K H)^T + K Q K^T, evaluated as written with X = I - K H
+  /// formed on the columns H touches: three n x n x k products and an n x n temporary.
+  /// Keeps P positive semi-definite where the symmetric form cancels (docs/ekf_covariance_update.md).
   joseph,
 };
 
@@ -89,8 +93,9 @@ class EkfSlam {
   /// the covariance decrease.
   struct Correction {
     Eigen::VectorXd delta;
-    Eigen::MatrixXd C;        ///< P H^T (n x Zk)
-    Eigen::MatrixXd L;        ///< lower Cholesky factor of the innovation covariance S
+    State x;                   ///< plus(x, delta_x), the corrected robot state
+    Eigen::MatrixXd W;         ///< symmetric form: L^-1 C^T (Zk x n), P' = P - W^T W
+    Eigen::MatrixXd P_joseph;  ///< Joseph form: the whole corrected P
   };
 
   static Eigen::Index offset_of(std::size_t slot) { return X + M * static_cast<Eigen::Index>(slot); }
@@ -107,6 +112,7 @@ class EkfSlam {
   Eigen::Matrix<double, Eigen::Dynamic, Z> cross_covariance(const Linearized& obs) const;
   void gate(std::vector<Linearized>& observations, UpdateResult& result) const;
   Correction compute_correction(const std::vector<Linearized>& observations) const;
+  Eigen::MatrixXd joseph_covariance(const std::vector<Linearized>& observations, const Eigen::MatrixXd& K) const;
   Plan plan(std::span<const ObservationType> known, std::span<const ObservationType> fresh, UpdateResult& result) const;
   void commit(const Plan& plan);
   void apply(const Correction& correction);

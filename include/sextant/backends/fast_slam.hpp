@@ -39,6 +39,9 @@ struct FastSlamOptions {
   /// Default chi2(2 dof) at 0.9999: at 0.99 one re-observation in a hundred would become a duplicate
   /// (seen on the ship, where a 2-3 sigma compass error happens every few dozen steps).
   double new_landmark_nis = 18.42;
+  /// Ids given to the landmarks that particles create in update_unassociated: first, first + 1, ...
+  /// A landmark keeps its id in every particle that descends from the one that created it.
+  LandmarkId first_unassociated_id = LandmarkId{1} << 62;
 };
 
 /// One landmark of one particle: an EKF over its position (eqs. 75-78).
@@ -47,6 +50,7 @@ struct LandmarkGaussian {
   Eigen::Matrix<double, M, 1> mean = Eigen::Matrix<double, M, 1>::Zero();
   Eigen::Matrix<double, M, M> cov = Eigen::Matrix<double, M, M>::Identity();
   bool alive = true;  ///< false once removed
+  LandmarkId id = 0;  ///< the landmark's id (for landmarks a particle created by its own association)
 };
 
 /// FastSLAM: N particles, each a pose and a map of independent landmark EKFs. `Map` holds a
@@ -85,7 +89,9 @@ class FastSlam {
   UpdateResult update(std::span<const ObservationType> observations);
   UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }
   /// Measurements without ids: each particle associates them to its own landmarks by maximum
-  /// likelihood, or starts new ones (thesis §7.2).
+  /// likelihood, or starts new ones (thesis §7.2). A new landmark gets the next id from
+  /// options().first_unassociated_id on; `initialized` counts those of the most likely particle,
+  /// whose landmarks map() lists beside the known ones.
   UpdateResult update_unassociated(std::span<const Measurement> measurements);
 
   void remove_landmark(LandmarkId id);
@@ -96,8 +102,8 @@ class FastSlam {
   PoseEstimate pose() const;
   MapEstimate map() const;
   LandmarkEstimate<M> landmark(LandmarkId id) const;
-  bool has_landmark(LandmarkId id) const { return index_.contains(id); }
-  std::size_t num_landmarks() const { return index_.size(); }
+  bool has_landmark(LandmarkId id) const;
+  std::size_t num_landmarks() const;
   std::vector<LandmarkId> landmark_ids() const;
   const std::vector<Particle>& particles() const { return particles_; }
   /// Normalized weights of the particles.
@@ -113,21 +119,41 @@ class FastSlam {
     double dt;
   };
 
-  State sample(const State& mean, const Eigen::Matrix<double, X, X>& cov);
-  void apply_pending_motion_v1();
-  double update_landmark(Particle& particle, std::size_t index, const Measurement& z, bool unassociated);
+  /// What a step commits at its end: particles, random engine and estimate move together.
+  struct Transaction {
+    std::vector<Particle> particles;
+    std::mt19937_64 rng;
+    std::optional<PoseEstimate> estimate;
+    std::vector<PendingMotion> pending;
+    LandmarkId next_unassociated_id;
+    bool resampled = false;
+  };
+  Transaction begin() const { return {particles_, rng_, estimate_, pending_, next_unassociated_id_, false}; }
+  void commit(Transaction&& t);
+
+  static State sample(const State& mean, const Eigen::Matrix<double, X, X>& cov, std::mt19937_64& rng);
+  void apply_pending_motion_v1(Transaction& t) const;
+  double update_landmark(Particle& particle, std::size_t index, const Measurement& z, bool unassociated) const;
   void sample_v2_proposal(Particle& particle, const State& predicted, const Eigen::Matrix<double, X, X>& R,
-                          std::span<const ObservationType> known);
-  void normalize_and_resample();
-  PoseEstimate cloud_estimate() const;
-  std::size_t best_particle() const;
+                          std::span<const ObservationType> known, std::mt19937_64& rng) const;
+  void normalize_and_resample(Transaction& t) const;
+  PoseEstimate cloud_estimate(const std::vector<Particle>& cloud, const std::vector<PendingMotion>& pending) const;
+  static std::vector<double> normalized_weights(const std::vector<Particle>& particles);
+  bool is_current(std::size_t index) const {
+    const auto it = index_.find(id_of_index_[index]);
+    return it != index_.end() && it->second == index;
+  }
+  static std::size_t best_particle(const std::vector<Particle>& particles);
+  std::size_t best_particle() const { return best_particle(particles_); }
+  std::optional<LandmarkEstimate<M>> unassociated_landmark(LandmarkId id) const;
 
   Motion motion_;
   Sensor sensor_;
   FastSlamOptions options_;
   std::vector<Particle> particles_;
   std::unordered_map<LandmarkId, std::size_t> index_;  ///< id -> index in every particle's map
-  std::vector<LandmarkId> id_of_index_;
+  std::vector<LandmarkId> id_of_index_;  ///< index -> id; an index whose id was removed is stale
+  LandmarkId next_unassociated_id_;
   std::vector<PendingMotion> pending_;  ///< v2: motion not yet sampled
   std::mt19937_64 rng_;
   std::size_t resamplings_ = 0;

@@ -15,6 +15,7 @@
 #include "sextant/core/selected_inverse.hpp"
 #include "sextant/core/sparse_cholesky.hpp"
 #include "sextant/core/update_result.hpp"
+#include "sextant/core/versioned_cache.hpp"
 
 namespace sextant {
 
@@ -48,6 +49,7 @@ struct GraphOptions {
 struct OptimizationSummary {
   int iterations = 0;
   std::vector<double> cost;   ///< chi2 at the start and after every iteration
+  std::vector<double> seconds;  ///< time since optimize() began at each entry of cost
   bool converged = false;
   double seconds_linearize = 0.0, seconds_eliminate = 0.0, seconds_solve = 0.0, seconds_recover = 0.0;
 };
@@ -92,8 +94,11 @@ class GraphSlam {
   /// Replaces the current estimate (e.g. with a filter's trajectory and map) before optimize().
   void warm_start(std::span<const State> poses, const MapEstimate& map);
 
-  /// The newest pose with its marginal covariance.
-  PoseEstimate pose() const;
+  /// The newest pose, O(1): its current mean, and as covariance its exact marginal as of the last
+  /// optimize(), propagated by the motion model (G P G^T + R) through the poses added since, the
+  /// uncertainty of the dead-reckoned mean that pose holds until the next optimize(). Measurements
+  /// recorded since the last optimize() do not shrink it. trajectory() gives exact marginals.
+  PoseEstimate pose() const { return {poses_.back(), newest_cov_}; }
   /// Every pose x_0 .. x_K with its marginal covariance.
   std::vector<PoseEstimate> trajectory() const;
   LandmarkEstimate<M> landmark(LandmarkId id) const;
@@ -135,10 +140,12 @@ class GraphSlam {
   Eigen::VectorXd solve_full(const Linearization& system, OptimizationSummary& summary) const;
   Eigen::VectorXd solve(const Linearization& system, double lambda, OptimizationSummary& summary) const;
   void apply(const Linearization& system, const Eigen::VectorXd& delta);
-  OptimizationSummary gauss_newton(std::size_t pose_count, int max_iterations);
+  OptimizationSummary gauss_newton(std::size_t pose_count, int max_iterations, Linearization* final_system = nullptr);
   void reinitialize_after(std::size_t pose_count);
   void initialize_in_windows();
-  const SelectedInverse& marginals() const;
+  std::shared_ptr<const SelectedInverse> marginals() const;
+  bool uses_landmark_schur(const Linearization& system) const;
+  Eigen::Matrix<double, X, X> newest_pose_marginal(const Linearization& system);
   Landmark landmark_mean(std::size_t slot) const { return landmark_means_.template segment<M>(M * slot); }
   void touch() { ++revision_; }
 
@@ -155,9 +162,9 @@ class GraphSlam {
   LandmarkPool pool_;
   bool windows_done_ = false;
   std::uint64_t revision_ = 0;
-  mutable SparseCholesky solver_;  ///< keeps the symbolic analysis while the pattern is unchanged
-  mutable std::shared_ptr<const SelectedInverse> marginals_;
-  mutable std::uint64_t marginals_revision_ = ~std::uint64_t{0};
+  Eigen::Matrix<double, X, X> newest_cov_;  ///< see pose()
+  mutable SparseCholesky solver_;  ///< keeps the symbolic analysis while the pattern is unchanged (non-const paths only)
+  VersionedCache<SelectedInverse> marginals_;  ///< at revision_ (thread-safe)
 };
 
 }  // namespace sextant

@@ -6,6 +6,8 @@
 #include <Eigen/SparseCore>
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <utility>
 #include <span>
 #include <vector>
 
@@ -15,6 +17,7 @@
 #include "sextant/core/linearized_observation.hpp"
 #include "sextant/core/sparse_information.hpp"
 #include "sextant/core/update_result.hpp"
+#include "sextant/core/versioned_cache.hpp"
 
 namespace sextant {
 
@@ -74,7 +77,9 @@ class SeifSlam {
   /// Solves Omega delta = r exactly (sparse Cholesky) and moves the whole mean to it.
   void recover_mean_exactly();
 
-  /// Pose mean (as recovered) with its marginal covariance by a sparse solve.
+  /// Pose mean (as recovered) with its marginal covariance by sparse solves with the Cholesky
+  /// factor of Omega, computed once per change of the filter (O(nnz of the factor)) and shared by
+  /// pose(), landmark() and map(). Const methods may be called from several threads at once.
   PoseEstimate pose() const;
   LandmarkEstimate<M> landmark(LandmarkId id) const;
   MapEstimate map() const;
@@ -118,13 +123,27 @@ class SeifSlam {
   NewLandmark new_landmark(const ObservationType& observation) const;
   void add(const MeasurementInformation& info);
   void augment(const NewLandmark& landmark);
+  /// What a failed step restores besides the information form (which journals itself).
+  struct Undo {
+    State x;
+    std::vector<std::pair<std::size_t, Landmark>> means;  ///< old means of moved landmarks, in order
+    std::optional<Eigen::VectorXd> all_means;             ///< every mean, when an exact recovery moved all
+    std::vector<std::size_t> active_queue;
+    std::uint64_t updates;
+    std::size_t landmarks;
+  };
+  template <class Step>
+  void atomically(Step step);
+  void move_landmark_mean(std::size_t slot, const Eigen::Matrix<double, M, 1>& dm);
+  void require_finite_robot_and_active(const char* what) const;
+  void recover_mean_exactly_in_transaction();
   void recover_mean_locally();
   void recover_mean_by_coordinate_descent();
   void recover_mean_of_active_block();
   Eigen::MatrixXd robot_and_landmarks_block(const std::vector<std::size_t>& slots) const;
   void update_active_queue(const std::vector<std::size_t>& observed_slots);
   void sparsify();
-  const Factor& factorization() const;
+  std::shared_ptr<const Factor> factorization() const;
   Eigen::MatrixXd marginal_covariance(Eigen::Index offset, Eigen::Index size) const;
   void touch() { ++revision_; }
 
@@ -138,8 +157,8 @@ class SeifSlam {
   std::vector<std::size_t> active_queue_;  ///< slots linked to the robot, most recently observed first
   std::uint64_t updates_ = 0;
   std::uint64_t revision_ = 0;
-  mutable std::shared_ptr<const Factor> factor_;  ///< cached factorization of Omega at factor_revision_
-  mutable std::uint64_t factor_revision_ = ~std::uint64_t{0};
+  Undo* undo_ = nullptr;  ///< the open transaction's undo record
+  VersionedCache<Factor> factor_;  ///< factorization of Omega at revision_ (thread-safe)
 };
 
 }  // namespace sextant

@@ -3,13 +3,17 @@
 /// matrix Omega, stored by blocks (robot, robot-landmark links, landmark diagonals, landmark-landmark
 /// links), and the residual r = xi - Omega mu of the information vector at the current mean mu.
 /// The mean that the form implies is mu + Omega^-1 r; mean recovery drives r to zero.
+/// A transaction (begin_transaction / commit / rollback) records the old value of every block it
+/// touches, so a filter step that fails half-way is undone in O(touched blocks), not O(map).
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "sextant/core/error.hpp"
@@ -32,7 +36,7 @@ class SparseInformation {
   std::size_t num_landmarks() const { return diagonal_.size(); }
   Eigen::Index dim() const { return X + M * static_cast<Eigen::Index>(num_landmarks()); }
 
-  RobotBlock& robot() { return robot_; }
+  RobotBlock& robot() { return robot_; }  // saved whole when a transaction begins
   const RobotBlock& robot() const { return robot_; }
   RobotVector& robot_residual() { return robot_residual_; }
   const RobotVector& robot_residual() const { return robot_residual_; }
@@ -47,15 +51,23 @@ class SparseInformation {
   void set_robot_link(std::size_t slot, const CrossBlock& block) { robot_links_[slot] = block; }
   void remove_robot_link(std::size_t slot) { robot_links_.erase(slot); }
 
-  LandmarkBlock& diagonal(std::size_t slot) { return diagonal_[slot]; }
+  LandmarkBlock& diagonal(std::size_t slot) {
+    save(slot);
+    return diagonal_[slot];
+  }
   const LandmarkBlock& diagonal(std::size_t slot) const { return diagonal_[slot]; }
-  auto landmark_residual(std::size_t slot) { return landmark_residual_.template segment<M>(M * slot); }
+  auto landmark_residual(std::size_t slot) {
+    save(slot);
+    return landmark_residual_.template segment<M>(M * slot);
+  }
   auto landmark_residual(std::size_t slot) const { return landmark_residual_.template segment<M>(M * slot); }
 
   /// Landmark-landmark links of a slot (both directions are stored).
   const Links& links(std::size_t slot) const { return links_[slot]; }
   /// Omega_{i, j} += block and Omega_{j, i} += block^T, for i != j.
   void add_to_link(std::size_t i, std::size_t j, const LandmarkBlock& block) {
+    save(i);
+    save(j);
     add_or_insert(links_[i], j, block);
     add_or_insert(links_[j], i, block.transpose());
   }
@@ -93,9 +105,22 @@ class SparseInformation {
     return out;
   }
   void set_residual(const Eigen::VectorXd& r) {
+    for (std::size_t slot = 0; slot < num_landmarks(); ++slot) save(slot);
     robot_residual_ = r.template head<X>();
     landmark_residual_ = r.tail(r.size() - X);
   }
+
+  /// Starts recording: until commit() or rollback(), every block changed through this interface
+  /// keeps its old value. Landmarks may be appended; marginalize_landmark is not allowed.
+  void begin_transaction() {
+    if (journal_) throw error("SparseInformation: a transaction is already open");
+    journal_.emplace(Journal{robot_, robot_residual_, robot_links_, num_landmarks(), {}, {}});
+  }
+  /// Keeps every change since begin_transaction().
+  void commit() { journal_.reset(); }
+  /// Restores the form exactly as it was at begin_transaction().
+  void rollback();
+  bool in_transaction() const { return journal_.has_value(); }
 
   /// Approximate heap bytes held (blocks and hash-map nodes), for memory reports.
   std::size_t memory_bytes() const;
@@ -107,6 +132,26 @@ class SparseInformation {
     if (!inserted) it->second += block;
   }
   void move_slot(std::size_t from, std::size_t to);
+  /// In a transaction, keeps the old blocks of a slot that existed when it began (once).
+  void save(std::size_t slot) {
+    if (!journal_ || slot >= journal_->landmarks || !journal_->saved.insert(slot).second) return;
+    journal_->slots.push_back({slot, diagonal_[slot], landmark_residual_.template segment<M>(M * slot), links_[slot]});
+  }
+
+  struct SavedSlot {
+    std::size_t slot;
+    LandmarkBlock diagonal;
+    LandmarkVector residual;
+    Links links;
+  };
+  struct Journal {
+    RobotBlock robot;
+    RobotVector robot_residual;
+    std::unordered_map<std::size_t, CrossBlock> robot_links;
+    std::size_t landmarks;                   ///< landmarks when the transaction began
+    std::vector<SavedSlot> slots;
+    std::unordered_set<std::size_t> saved;
+  };
 
   RobotBlock robot_;
   RobotVector robot_residual_;
@@ -114,10 +159,30 @@ class SparseInformation {
   std::vector<LandmarkBlock> diagonal_;
   std::vector<Links> links_;
   Eigen::VectorXd landmark_residual_;
+  std::optional<Journal> journal_;
 };
 
 template <int X, int M>
+void SparseInformation<X, M>::rollback() {
+  if (!journal_) return;
+  Journal journal = std::move(*journal_);
+  journal_.reset();
+  robot_ = journal.robot;
+  robot_residual_ = journal.robot_residual;
+  robot_links_ = std::move(journal.robot_links);
+  diagonal_.resize(journal.landmarks);
+  links_.resize(journal.landmarks);
+  landmark_residual_.conservativeResize(M * static_cast<Eigen::Index>(journal.landmarks));
+  for (auto& saved : journal.slots) {
+    diagonal_[saved.slot] = saved.diagonal;
+    landmark_residual_.template segment<M>(M * saved.slot) = saved.residual;
+    links_[saved.slot] = std::move(saved.links);
+  }
+}
+
+template <int X, int M>
 void SparseInformation<X, M>::marginalize_landmark(std::size_t slot) {
+  if (journal_) throw error("SparseInformation: marginalize_landmark inside a transaction");
   const Eigen::LLT<LandmarkBlock> llt(diagonal_[slot]);
   if (llt.info() != Eigen::Success)
     throw numerical_error("information block of the landmark to marginalize is not positive definite");

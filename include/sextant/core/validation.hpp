@@ -3,6 +3,7 @@
 /// back-ends call them before touching their state.
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <concepts>
 #include <span>
@@ -26,6 +27,25 @@ void require_finite(const T& value, const std::string& what) {
 inline void require_positive_time_step(double dt) {
   if (!std::isfinite(dt) || dt <= 0.0)
     throw invalid_input_error("time step dt must be finite and > 0, got " + std::to_string(dt));
+}
+
+/// Throws numerical_error unless the process noise R of a motion step is finite, symmetric and
+/// positive semi-definite, each up to rounding (relative 1e-9 of its largest entry): the one check
+/// every back-end applies, so that none of them repairs (symmetrizes, clips) a broken model silently.
+template <class Derived>
+void require_process_noise(const Eigen::MatrixBase<Derived>& R) {
+  if (!R.allFinite()) throw numerical_error("process noise R has NaN or Inf entries");
+  const double scale = R.cwiseAbs().maxCoeff();
+  const double tolerance = 1e-9 * scale;
+  if (!((R - R.transpose()).cwiseAbs().maxCoeff() <= tolerance))
+    throw numerical_error("process noise R is not symmetric");
+  const typename Derived::PlainObject symmetric = 0.5 * (R + R.transpose());
+  const double smallest = Eigen::SelfAdjointEigenSolver<typename Derived::PlainObject>(symmetric, Eigen::EigenvaluesOnly)
+                              .eigenvalues()
+                              .minCoeff();
+  if (!(smallest >= -tolerance))
+    throw numerical_error("process noise R is not positive semi-definite (smallest eigenvalue " +
+                          std::to_string(smallest) + ")");
 }
 
 /// Throws when an observation is not finite or a landmark id repeats within one update.

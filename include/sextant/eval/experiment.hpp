@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "sextant/eval/alignment.hpp"
 #include "sextant/eval/metrics.hpp"
 #include "sextant/eval/runner.hpp"
 
@@ -27,11 +28,48 @@ struct RunSummary {
   std::vector<State> trajectory;   ///< pose mean after each step
   std::vector<double> map_error;   ///< AE of each landmark of the final map (eq. 109)
   std::vector<double> map_nees;    ///< NEES of each landmark of the final map (eq. 111)
+  std::vector<double> pose_error_aligned;  ///< position error after rigid alignment of the trajectory to the truth
+  std::vector<double> map_error_aligned;   ///< landmark error after rigid alignment of the final map to the truth
   /// The thesis's map MAE "over time": the mean landmark error of the map held after each step,
   /// averaged over the steps (a filter's early maps count); for full SLAM, the final map's.
   double map_error_over_time = 0.0;
   double total_seconds = 0.0;
 };
+
+namespace detail {
+/// Errors after the best rigid alignment of `estimate` onto `truth` (points of dimension dim, 2 or
+/// 3, given as the leading entries of each vector); empty for other dimensions.
+template <class A, class B>
+std::vector<double> aligned_position_errors(const std::vector<A>& estimate, const std::vector<B>& truth, int dim) {
+  auto run = [&]<int D>() {
+    std::vector<Eigen::Matrix<double, D, 1>> e, t;
+    for (std::size_t i = 0; i < estimate.size(); ++i) {
+      e.push_back(estimate[i].template head<D>());
+      t.push_back(truth[i].template head<D>());
+    }
+    return aligned_errors<D>(e, t);
+  };
+  if (dim == 2) return run.template operator()<2>();
+  if (dim == 3) return run.template operator()<3>();
+  return {};
+}
+
+/// Aligned errors of the trajectory (pose after step k against true pose k + 1) and of the map.
+template <class Summary, class Map, class Dataset>
+void add_aligned_errors(Summary& out, const Map& map, const Dataset& dataset, int position_dim) {
+  std::vector<std::decay_t<decltype(dataset.true_poses[0])>> truth(dataset.true_poses.begin() + 1,
+                                                                   dataset.true_poses.begin() + 1 + out.trajectory.size());
+  if (position_dim < 0) position_dim = static_cast<int>(truth.empty() ? 0 : truth.front().size());
+  out.pose_error_aligned = aligned_position_errors(out.trajectory, truth, position_dim);
+  using Point = std::decay_t<decltype(map.front().mean)>;
+  std::vector<Point> estimated, true_points;
+  for (const auto& landmark : map) {
+    estimated.push_back(landmark.mean);
+    true_points.push_back(dataset.true_landmarks.at(landmark.id));
+  }
+  out.map_error_aligned = aligned_position_errors(estimated, true_points, static_cast<int>(Point::RowsAtCompileTime));
+}
+}  // namespace detail
 
 /// Runs `backend` over dataset.steps and scores it against dataset.true_poses (row k + 1 is the
 /// pose after step k) and dataset.true_landmarks. The position error is the norm of the first
@@ -61,10 +99,12 @@ RunSummary<typename Backend::State> evaluate_run(Backend& backend, const Dataset
     out.seconds.push_back(record.steps[k].seconds);
     out.trajectory.push_back(pose.mean);
   }
-  auto map = evaluate_map(backend.map(), dataset.true_landmarks);
+  const auto final_map = backend.map();
+  auto map = evaluate_map(final_map, dataset.true_landmarks);
   out.map_error = std::move(map.errors);
   out.map_nees = std::move(map.nees);
   out.total_seconds = record.total_seconds;
+  detail::add_aligned_errors(out, final_map, dataset, position_dim);
   return out;
 }
 
@@ -97,17 +137,21 @@ RunSummary<typename Backend::State> evaluate_smoothed_run(Backend& backend, cons
     out.pose_nees.push_back(nees_or_infinity(error, trajectory[k].cov));
     out.trajectory.push_back(trajectory[k].mean);
   }
-  auto map = evaluate_map(backend.map(), dataset.true_landmarks);
+  const auto final_map = backend.map();
+  auto map = evaluate_map(final_map, dataset.true_landmarks);
   out.map_error = std::move(map.errors);
   out.map_nees = std::move(map.nees);
   out.map_error_over_time = mean(out.map_error);
+  detail::add_aligned_errors(out, final_map, dataset, position_dim);
   return out;
 }
 
 /// Averages over runs: MAE of pose and map, share of NEES inside the one-sided bound, time, and
-/// with two or more runs the pose ANEES with its two-sided interval.
+/// with two or more runs the pose ANEES (over runs and steps) with the two-sided interval of that
+/// average (time_averaged_anees_interval).
 struct Summary {
   double pose_mae = 0.0, map_mae = 0.0, map_mae_over_time = 0.0;
+  double pose_mae_aligned = 0.0, map_mae_aligned = 0.0;  ///< after rigid alignment to the truth
   double pose_nees_inside = 0.0, map_nees_inside = 0.0;  ///< fractions in [0, 1]
   double total_seconds = 0.0, seconds_per_step = 0.0;
   double pose_anees = 0.0;
@@ -121,8 +165,7 @@ Summary summarize(const std::vector<RunSummary<State>>& runs, int pose_dof, int 
   Summary s;
   if (runs.empty()) return s;
   const double n = static_cast<double>(runs.size());
-  std::vector<double> pose_maes, map_maes;
-  std::vector<std::vector<double>> nees_runs;
+  std::vector<double> pose_maes, map_maes, nees_averages;
   for (const auto& r : runs) {
     pose_maes.push_back(mean(r.pose_error));
     map_maes.push_back(mean(r.map_error));
@@ -130,7 +173,9 @@ Summary summarize(const std::vector<RunSummary<State>>& runs, int pose_dof, int 
     s.map_nees_inside += fraction_at_most(r.map_nees, nees_upper_bound(landmark_dof, confidence)) / n;
     s.total_seconds += r.total_seconds / n;
     s.map_mae_over_time += r.map_error_over_time / n;
-    nees_runs.push_back(r.pose_nees);
+    s.pose_mae_aligned += mean(r.pose_error_aligned) / n;
+    s.map_mae_aligned += mean(r.map_error_aligned) / n;
+    nees_averages.push_back(mean(r.pose_nees));
   }
   auto standard_deviation = [](const std::vector<double>& v) {
     const double m = mean(v);
@@ -143,8 +188,9 @@ Summary summarize(const std::vector<RunSummary<State>>& runs, int pose_dof, int 
   s.pose_mae_std = standard_deviation(pose_maes);
   s.map_mae_std = standard_deviation(map_maes);
   s.seconds_per_step = s.total_seconds / static_cast<double>(std::max<std::size_t>(1, runs.front().seconds.size()));
-  s.pose_anees = mean(anees_per_step(nees_runs));
-  if (runs.size() > 1) s.anees_interval = anees_interval(pose_dof, static_cast<int>(runs.size()), confidence);
+  s.pose_anees = mean(nees_averages);
+  if (runs.size() > 1 && std::isfinite(s.pose_anees))
+    s.anees_interval = time_averaged_anees_interval(pose_dof, nees_averages, confidence);
   return s;
 }
 

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <boost/math/distributions/students_t.hpp>
+
 #include "sextant/core/chi_square.hpp"
 #include "sextant/core/error.hpp"
 #include "sextant/core/gaussian.hpp"
@@ -76,6 +78,24 @@ inline Interval anees_interval(int dof, int runs, double confidence = 0.95) {
   const double total_dof = static_cast<double>(dof) * runs;
   const double tail = 0.5 * (1.0 - confidence);
   return {chi_square_quantile(total_dof, tail) / runs, chi_square_quantile(total_dof, 1.0 - tail) / runs};
+}
+
+/// Two-sided interval, under consistency, of the NEES averaged over K steps and N runs. The runs
+/// are independent but the steps of one run are not (the error at step k carries into k + 1), so
+/// no chi-square with N K dof applies. Each run's time average a_i = (1/K) sum_k NEES_ik has mean
+/// dof; the a_i are i.i.d., so their mean lies in dof +- t_{N-1} s / sqrt(N) (s: sample standard
+/// deviation of the a_i; Student's t at the given confidence). Needs N >= 2.
+inline Interval time_averaged_anees_interval(int dof, std::span<const double> per_run_averages,
+                                             double confidence = 0.95) {
+  const std::size_t n = per_run_averages.size();
+  if (n < 2) throw invalid_input_error("time_averaged_anees_interval needs at least 2 runs");
+  const double mean_value = mean(per_run_averages);
+  double sum_sq = 0.0;
+  for (double a : per_run_averages) sum_sq += (a - mean_value) * (a - mean_value);
+  const double s = std::sqrt(sum_sq / static_cast<double>(n - 1));
+  const double t = boost::math::quantile(boost::math::students_t(static_cast<double>(n - 1)), 0.5 * (1.0 + confidence));
+  const double half_width = t * s / std::sqrt(static_cast<double>(n));
+  return {dof - half_width, dof + half_width};
 }
 
 /// Per-step ANEES: element-wise mean over runs of per-step NEES series of equal length.

@@ -17,8 +17,9 @@ enum class HeadingNoise {
   /// displacement by 3.4% at 15 degrees, a bias that accumulates on legs without beacons.
   linearized,
   /// Unbiased: the mean is scaled by exp(sigma^2 / 2), which makes it an unbiased estimate of the
-  /// true displacement, and R is the exact covariance of its error for Gaussian speed and heading
-  /// noise (derivation in docs/derivations/ship_heading_noise.md).
+  /// true displacement, and R is the covariance of its error for Gaussian speed and heading noise,
+  /// averaged over the true heading the filter knows only to sigma (derivation in
+  /// docs/derivations/ship_heading_noise.md).
   unbiased,
 };
 
@@ -51,7 +52,8 @@ struct BeaconShip2D {
       out.x = x + dt * v * std::exp(0.5 * var_h) * Eigen::Vector2d(c, s);
       // Error covariance dt^2/2 [a I + b Rot(2 heading)], Rot(t) = [cos t, sin t; sin t, -cos t].
       const double a = speed_second_moment * std::exp(var_h) - v * v;
-      const double b = speed_second_moment * std::exp(-var_h) - v * v;
+      // The filter knows the heading only to sigma: averaged over it, E[Rot(2h)] = exp(-2 var_h) Rot(2 h_m).
+      const double b = std::exp(-2.0 * var_h) * (speed_second_moment * std::exp(-var_h) - v * v);
       const double c2 = c * c - s * s, s2 = 2.0 * s * c;
       Eigen::Matrix2d rot;
       rot << c2, s2, s2, -c2;

@@ -1,6 +1,7 @@
 #pragma once
 // Bodies of EkfSlam (see ../ekf_slam.hpp).
 
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -20,6 +21,7 @@ EkfSlam<Motion, Sensor>::EkfSlam(Motion motion, Sensor sensor, const PoseEstimat
 }
 
 /// Thesis eqs. (10)-(13): mu' = g(u, mu); P_xx' = G P_xx G^T + R; P_xm' = G P_xm. O(n).
+/// The new blocks are computed and checked first, then written.
 template <class Motion, class Sensor>
 void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   require_finite(u, "control");
@@ -27,12 +29,15 @@ void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   const auto prediction = motion_.predict(x_, u, dt);
   if (!Space::is_finite(prediction.x) || !prediction.J_x_x.allFinite() || !prediction.R.allFinite())
     throw numerical_error("motion model returned NaN or Inf");
+  require_process_noise(prediction.R);
   auto P = cov_.view();
   const auto& G = prediction.J_x_x;
   const Eigen::Index rest = P.rows() - X;
-  P.template topLeftCorner<X, X>() =
-      symmetrized(G * symmetric_diagonal_block<X>(P, 0) * G.transpose() + prediction.R);
-  if (rest > 0) P.bottomLeftCorner(rest, X) = (P.bottomLeftCorner(rest, X) * G.transpose()).eval();
+  const Eigen::Matrix<double, X, X> P_xx = symmetrized(G * symmetric_diagonal_block<X>(P, 0) * G.transpose() + prediction.R);
+  const Eigen::MatrixXd P_mx = P.bottomLeftCorner(rest, X) * G.transpose();
+  if (!P_xx.allFinite() || !P_mx.allFinite()) throw numerical_error("EKF motion update overflowed (NaN or Inf)");
+  P.template topLeftCorner<X, X>() = P_xx;
+  P.bottomLeftCorner(rest, X) = P_mx;
   x_ = prediction.x;
 }
 
@@ -101,48 +106,93 @@ void EkfSlam<Motion, Sensor>::gate(std::vector<Linearized>& observations, Update
   observations = std::move(kept);
 }
 
-/// Thesis eqs. (14)-(16) for k observations at once: C = P H^T, S = H C + Q, delta = C S^-1 nu.
+/// Thesis eqs. (14)-(16) for k observations at once: C = P H^T, S = H C + Q, delta = C S^-1 nu;
+/// and the factors of the covariance correction, checked for overflow before anything changes.
 template <class Motion, class Sensor>
 auto EkfSlam<Motion, Sensor>::compute_correction(const std::vector<Linearized>& observations) const -> Correction {
   const Eigen::Index n = state_dim(), k = static_cast<Eigen::Index>(observations.size());
-  Correction out;
-  out.C.resize(n, Z * k);
+  Eigen::MatrixXd C(n, Z * k);
   Eigen::VectorXd nu(Z * k);
   for (Eigen::Index i = 0; i < k; ++i) {
-    out.C.template middleCols<Z>(Z * i) = cross_covariance(observations[i]);
+    C.template middleCols<Z>(Z * i) = cross_covariance(observations[i]);
     nu.template segment<Z>(Z * i) = observations[i].residual;
   }
   Eigen::MatrixXd S(Z * k, Z * k);
   for (Eigen::Index i = 0; i < k; ++i) {
     const auto& obs = observations[i];
     S.template middleRows<Z>(Z * i) =
-        obs.J_z_x * out.C.template topRows<X>() + obs.J_z_m * out.C.template middleRows<M>(obs.offset);
+        obs.J_z_x * C.template topRows<X>() + obs.J_z_m * C.template middleRows<M>(obs.offset);
     S.template block<Z, Z>(Z * i, Z * i) += obs.Q;
   }
   const auto llt = cholesky_or_throw(symmetrized(S), "innovation covariance S");
-  out.L = llt.matrixL();
-  out.delta = out.C * llt.solve(nu);
+  Correction out;
+  out.delta = C * llt.solve(nu);
   if (!out.delta.allFinite()) throw numerical_error("EKF correction is not finite");
+  out.x = Space::plus(x_, out.delta.template head<X>());
+  if (!Space::is_finite(out.x)) throw numerical_error("EKF correction of the robot state is not finite");
+  if (options_.covariance_update == CovarianceUpdate::symmetric) {
+    out.W = llt.matrixL().solve(C.transpose());
+    // |(W^T W)_ij| <= max_i |W_i|^2: with that and |P| below half the double range, P - W^T W is finite.
+    const double largest = out.W.size() ? out.W.colwise().squaredNorm().maxCoeff() : 0.0;
+    if (!out.W.allFinite() || !(largest < 0.25 * std::numeric_limits<double>::max()))
+      throw numerical_error("EKF covariance correction would overflow");
+  } else {
+    const Eigen::MatrixXd K = llt.solve(C.transpose()).transpose();
+    out.P_joseph = joseph_covariance(observations, K);
+    if (!out.P_joseph.allFinite()) throw numerical_error("EKF covariance correction (Joseph form) is not finite");
+  }
   return out;
 }
 
-/// Commits a correction: mean by plus (error state), covariance by eq. (17) or Joseph form.
+/// Joseph form (I - K H) P (I - K H)^T + K Q K^T as written, with X = I - K H formed explicitly on
+/// the columns S that H touches (robot and observed landmarks) and equal to I elsewhere:
+///   A = X P:    rows S of A = X_SS P_S,   other rows = P_i + X_iS P_S   (P_S: rows S of P);
+///   B = A X^T:  columns S of B = A_:S X_SS^T,  other columns = A_:j + A_:S X_jS^T;
+///   P' = B + K Q K^T.
+/// Rows and columns in S come out as products with the small entries of X_SS instead of as the
+/// difference of two large numbers (the cancellation of eq. 17). O(n^2 |S|) with three products.
+template <class Motion, class Sensor>
+Eigen::MatrixXd EkfSlam<Motion, Sensor>::joseph_covariance(const std::vector<Linearized>& observations,
+                                                           const Eigen::MatrixXd& K) const {
+  const Eigen::Index zk = K.cols();
+  std::vector<Eigen::Index> support;  // S: robot, then each observed landmark's block (distinct ids)
+  for (Eigen::Index i = 0; i < X; ++i) support.push_back(i);
+  for (const auto& obs : observations)
+    for (Eigen::Index i = 0; i < M; ++i) support.push_back(obs.offset + i);
+  const Eigen::Index s = static_cast<Eigen::Index>(support.size());
+  Eigen::MatrixXd H_S = Eigen::MatrixXd::Zero(zk, s);
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    const Eigen::Index row = Z * static_cast<Eigen::Index>(i);
+    H_S.block(row, 0, Z, X) = observations[i].J_z_x;
+    H_S.block(row, X + M * static_cast<Eigen::Index>(i), Z, M) = observations[i].J_z_m;
+  }
+  Eigen::MatrixXd X_S = -K * H_S;  // X restricted to the columns S
+  for (Eigen::Index j = 0; j < s; ++j) X_S(support[j], j) += 1.0;
+  const Eigen::MatrixXd P = covariance();
+  const Eigen::MatrixXd P_S = P(support, Eigen::all);
+  Eigen::MatrixXd A = P;
+  A(support, Eigen::all).setZero();
+  A.noalias() += X_S * P_S;
+  Eigen::MatrixXd A_S = A(Eigen::all, support);
+  A(Eigen::all, support).setZero();
+  A.noalias() += A_S * X_S.transpose();
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(zk, zk);
+  for (std::size_t i = 0; i < observations.size(); ++i)
+    Q.block(Z * static_cast<Eigen::Index>(i), Z * static_cast<Eigen::Index>(i), Z, Z) = observations[i].Q;
+  const Eigen::MatrixXd KQ = K * Q;
+  A.noalias() += KQ * K.transpose();
+  return symmetrized(A);
+}
+
+/// Commits a planned correction: nothing here can fail.
 template <class Motion, class Sensor>
 void EkfSlam<Motion, Sensor>::apply(const Correction& correction) {
   auto P = cov_.view();
-  const auto L = correction.L.template triangularView<Eigen::Lower>();
-  if (options_.covariance_update == CovarianceUpdate::symmetric) {
-    const Eigen::MatrixXd W = L.solve(correction.C.transpose());  // P -= C S^-1 C^T = W^T W
-    subtract_gram_lower(P, W);
-  } else {
-    // (I-KH)P(I-KH)^T + KQK^T = P - K C^T - C K^T + K S K^T with K = C S^-1.
-    const Eigen::MatrixXd K = L.transpose().solve(L.solve(correction.C.transpose())).transpose();
-    const Eigen::MatrixXd KL = K * correction.L;
-    auto lower = P.template selfadjointView<Eigen::Lower>();
-    for (Eigen::Index i = 0; i < K.cols(); ++i) lower.rankUpdate(K.col(i), correction.C.col(i), -1.0);
-    lower.rankUpdate(KL, 1.0);
-  }
-  x_ = Space::plus(x_, correction.delta.template head<X>());
+  if (options_.covariance_update == CovarianceUpdate::symmetric)
+    subtract_gram_lower(P, correction.W);
+  else
+    P.template triangularView<Eigen::Lower>() = correction.P_joseph;
+  x_ = correction.x;
   landmark_means_ += correction.delta.tail(correction.delta.size() - X);
 }
 
@@ -155,7 +205,7 @@ auto EkfSlam<Motion, Sensor>::plan(std::span<const ObservationType> known, std::
   State x_after = x_;
   if (!observations.empty()) {
     out.correction = compute_correction(observations);
-    x_after = Space::plus(x_, out.correction->delta.template head<X>());
+    x_after = out.correction->x;
     result.corrected += observations.size();
   }
   for (const auto& observation : fresh) {

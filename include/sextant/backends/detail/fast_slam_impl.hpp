@@ -24,61 +24,89 @@ double log_gaussian(const Llt& llt, const Vector& nu) {
 
 template <class Motion, class Sensor, template <class> class Map>
 FastSlam<Motion, Sensor, Map>::FastSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, FastSlamOptions options)
-    : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), rng_(options.seed) {
+    : motion_(std::move(motion)),
+      sensor_(std::move(sensor)),
+      options_(options),
+      next_unassociated_id_(options.first_unassociated_id),
+      rng_(options.seed) {
   if (options_.particles == 0) throw invalid_input_error("FastSlamOptions: particles must be > 0");
   if (!(options_.resample_threshold >= 0.0 && options_.resample_threshold <= 1.0))
     throw invalid_input_error("FastSlamOptions: resample_threshold must be in [0, 1]");
   if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
   cholesky_or_throw(prior.cov, "prior covariance");
   particles_.resize(options_.particles);
-  for (auto& particle : particles_) particle.x = sample(prior.mean, prior.cov);
+  for (auto& particle : particles_) particle.x = sample(prior.mean, prior.cov, rng_);
 }
 
-/// x = plus(mean, L n), n ~ N(0, I), with cov = L L^T from an LDL^T factorization (semi-definite allowed).
+/// x = plus(mean, L n), n ~ N(0, I), with cov = L L^T from an LDL^T factorization (semi-definite
+/// allowed; callers have checked that cov is positive semi-definite up to rounding).
 template <class Motion, class Sensor, template <class> class Map>
-auto FastSlam<Motion, Sensor, Map>::sample(const State& mean, const Eigen::Matrix<double, X, X>& cov) -> State {
+auto FastSlam<Motion, Sensor, Map>::sample(const State& mean, const Eigen::Matrix<double, X, X>& cov,
+                                           std::mt19937_64& rng) -> State {
   const Eigen::LDLT<Eigen::Matrix<double, X, X>> ldlt(cov);
   std::normal_distribution<double> unit(0.0, 1.0);
   Eigen::Matrix<double, X, 1> n;
-  for (int i = 0; i < X; ++i) n(i) = unit(rng_) * std::sqrt(std::max(ldlt.vectorD()(i), 0.0));
+  for (int i = 0; i < X; ++i) n(i) = unit(rng) * std::sqrt(std::max(ldlt.vectorD()(i), 0.0));
   const Eigen::Matrix<double, X, 1> d = ldlt.transpositionsP().transpose() * (ldlt.matrixL() * n);
-  return Space::plus(mean, d);
+  const State x = Space::plus(mean, d);
+  if (!Space::is_finite(x)) throw numerical_error("sampled particle pose is not finite");
+  return x;
 }
 
+namespace detail {
+/// The motion model's prediction, checked: finite, with a symmetric positive semi-definite R.
+template <class Motion, class State, class Control>
+auto checked_motion(const Motion& motion, const State& x, const Control& u, double dt) {
+  auto p = motion.predict(x, u, dt);
+  if (!Motion::Space::is_finite(p.x) || !p.R.allFinite()) throw numerical_error("motion model returned NaN or Inf");
+  require_process_noise(p.R);
+  return p;
+}
+}  // namespace detail
+
+template <class Motion, class Sensor, template <class> class Map>
+void FastSlam<Motion, Sensor, Map>::commit(Transaction&& t) {
+  particles_ = std::move(t.particles);
+  rng_ = t.rng;
+  estimate_ = std::move(t.estimate);
+  pending_ = std::move(t.pending);
+  next_unassociated_id_ = t.next_unassociated_id;
+  if (t.resampled) ++resamplings_;
+}
+
+/// FastSLAM 1.0 samples now; 2.0 keeps the motion pending for update()'s proposal (a second predict
+/// in a row samples the first one plainly). Either way every particle's motion is checked here.
 template <class Motion, class Sensor, template <class> class Map>
 void FastSlam<Motion, Sensor, Map>::predict(const Control& u, double dt) {
   require_finite(u, "control");
   require_positive_time_step(dt);
-  for (const auto& particle : particles_) {  // check the model once per particle before any change
-    const auto p = motion_.predict(particle.x, u, dt);
-    if (!Space::is_finite(p.x) || !p.R.allFinite()) throw numerical_error("motion model returned NaN or Inf");
-  }
-  estimate_.reset();
-  if (options_.version == FastSlamVersion::v2) {
-    apply_pending_motion_v1();  // two predicts in a row: the first one is sampled plainly
-    pending_.push_back({u, dt});
-    return;
-  }
-  pending_.push_back({u, dt});
-  apply_pending_motion_v1();
+  Transaction t = begin();
+  t.estimate.reset();
+  apply_pending_motion_v1(t);
+  t.pending.push_back({u, dt});
+  if (options_.version == FastSlamVersion::v1)
+    apply_pending_motion_v1(t);
+  else
+    for (const auto& particle : t.particles) detail::checked_motion(motion_, particle.x, u, dt);
+  commit(std::move(t));
 }
 
-/// FastSLAM 1.0 (eq. 74): every particle samples x ~ N(g(x, u), R).
+/// FastSLAM 1.0 (eq. 74): every particle samples x ~ N(g(x, u), R) for each pending motion.
 template <class Motion, class Sensor, template <class> class Map>
-void FastSlam<Motion, Sensor, Map>::apply_pending_motion_v1() {
-  for (const auto& motion : pending_)
-    for (auto& particle : particles_) {
-      const auto p = motion_.predict(particle.x, motion.u, motion.dt);
-      particle.x = sample(p.x, p.R);
+void FastSlam<Motion, Sensor, Map>::apply_pending_motion_v1(Transaction& t) const {
+  for (const auto& motion : t.pending)
+    for (auto& particle : t.particles) {
+      const auto p = detail::checked_motion(motion_, particle.x, motion.u, motion.dt);
+      particle.x = sample(p.x, p.R, t.rng);
     }
-  pending_.clear();
+  t.pending.clear();
 }
 
 /// One landmark EKF update with the particle's pose (eqs. 75-78, Joseph form); returns the log
 /// likelihood log N(nu; 0, S), S = H_m Sigma_m H_m^T + Q (eqs. 79-81).
 template <class Motion, class Sensor, template <class> class Map>
 double FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::size_t index, const Measurement& z,
-                                                      bool unassociated) {
+                                                      bool unassociated) const {
   auto& map = unassociated ? particle.unassociated : particle.landmarks;
   const LandmarkGaussian<M>& L = map[index];
   const auto pred = sensor_.predict(particle.x, L.mean);
@@ -87,7 +115,8 @@ double FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::s
   const auto llt = cholesky_or_throw(S, "landmark innovation covariance");
   const Eigen::Matrix<double, M, Z> K = llt.solve(pred.J_z_m * L.cov).transpose();
   const Eigen::Matrix<double, M, M> I_KH = Eigen::Matrix<double, M, M>::Identity() - K * pred.J_z_m;
-  LandmarkGaussian<M> updated{L.mean + K * nu, symmetrized(I_KH * L.cov * I_KH.transpose() + K * pred.Q * K.transpose()), true};
+  LandmarkGaussian<M> updated{L.mean + K * nu, symmetrized(I_KH * L.cov * I_KH.transpose() + K * pred.Q * K.transpose()),
+                              true, L.id};
   const double log_likelihood = detail::log_gaussian(llt, nu);
   if (!updated.mean.allFinite() || !updated.cov.allFinite() || !std::isfinite(log_likelihood))
     throw numerical_error("landmark update is not finite");
@@ -102,7 +131,8 @@ double FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::s
 template <class Motion, class Sensor, template <class> class Map>
 void FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const State& predicted,
                                                        const Eigen::Matrix<double, X, X>& R,
-                                                       std::span<const ObservationType> known) {
+                                                       std::span<const ObservationType> known,
+                                                       std::mt19937_64& rng) const {
   State mean = predicted;
   Eigen::Matrix<double, X, X> cov = R;
   for (const auto& observation : known) {
@@ -117,44 +147,46 @@ void FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const
     mean = Space::plus(mean, K * nu);
     cov = symmetrized((Eigen::Matrix<double, X, X>::Identity() - K * pred.J_z_x) * cov);
   }
-  particle.x = sample(mean, cov);
+  if (!std::isfinite(particle.log_weight)) throw numerical_error("FastSLAM 2.0 proposal weight is not finite");
+  particle.x = sample(mean, cov, rng);
 }
 
+/// Every step works on a copy of the particles (O(N) with shared maps) and of the random engine,
+/// and commits at its very end: the strong guarantee, resampling included.
 template <class Motion, class Sensor, template <class> class Map>
 UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationType> observations) {
   require_valid_observations(observations);
   std::vector<ObservationType> known, fresh;
   for (const auto& observation : observations)
     (index_.contains(observation.landmark_id) ? known : fresh).push_back(observation);
-  // Work on copies (O(N) with shared maps) and commit at the end: the strong guarantee.
-  std::vector<Particle> next = particles_;
-  const auto rng_before = rng_;
-  try {
-    for (auto& particle : next) {
-      if (options_.version == FastSlamVersion::v2 && !pending_.empty()) {
-        const auto p = motion_.predict(particle.x, pending_.back().u, pending_.back().dt);
-        sample_v2_proposal(particle, p.x, p.R, known);
-        for (const auto& observation : known) update_landmark(particle, index_.at(observation.landmark_id), observation.z, false);
-      } else {
-        for (const auto& observation : known)
-          particle.log_weight += update_landmark(particle, index_.at(observation.landmark_id), observation.z, false);
-      }
-      for (const auto& observation : fresh) {
-        const auto init = initialize_landmark(sensor_, particle.x, observation.z, observation.landmark_id);
-        particle.landmarks.push_back({init.m, symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose()), true});
-      }
+  Transaction t = begin();
+  const bool proposal = options_.version == FastSlamVersion::v2 && !t.pending.empty();
+  for (auto& particle : t.particles) {
+    if (proposal) {
+      const auto p = detail::checked_motion(motion_, particle.x, t.pending.back().u, t.pending.back().dt);
+      sample_v2_proposal(particle, p.x, p.R, known, t.rng);
+      for (const auto& observation : known) update_landmark(particle, index_.at(observation.landmark_id), observation.z, false);
+    } else {
+      for (const auto& observation : known)
+        particle.log_weight += update_landmark(particle, index_.at(observation.landmark_id), observation.z, false);
     }
-  } catch (...) {
-    rng_ = rng_before;
-    throw;
+    for (const auto& observation : fresh) {
+      const auto init = initialize_landmark(sensor_, particle.x, observation.z, observation.landmark_id);
+      particle.landmarks.push_back({init.m, symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose()), true,
+                                    observation.landmark_id});
+    }
   }
-  particles_ = std::move(next);
-  pending_.clear();
+  t.pending.clear();
+  normalize_and_resample(t);
+  auto index = index_;
+  auto id_of_index = id_of_index_;
   for (const auto& observation : fresh) {
-    index_.emplace(observation.landmark_id, id_of_index_.size());
-    id_of_index_.push_back(observation.landmark_id);
+    index[observation.landmark_id] = id_of_index.size();
+    id_of_index.push_back(observation.landmark_id);
   }
-  normalize_and_resample();
+  commit(std::move(t));
+  index_.swap(index);
+  id_of_index_.swap(id_of_index);
   return {known.size(), fresh.size(), {}};
 }
 
@@ -162,112 +194,120 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
 /// largest likelihood, or starts a new one when even the best is beyond the new-landmark gate. With
 /// FastSLAM 2.0 the association is decided inside the proposal, so the innovation covariance
 /// includes the pose's motion uncertainty (S = H_x Sigma_x H_x^T + H_m Sigma_m H_m^T + Q), and the
-/// pose is sampled after the associated measurements have shaped it.
+/// pose is sampled after the associated measurements have shaped it. A landmark started from the
+/// i-th measurement gets the id next_unassociated_id + i in every particle that starts it.
 template <class Motion, class Sensor, template <class> class Map>
 UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const Measurement> measurements) {
   for (const auto& z : measurements) require_finite(z, "unassociated measurement");
-  std::vector<Particle> next = particles_;
-  const auto rng_before = rng_;
-  const bool proposal = options_.version == FastSlamVersion::v2 && !pending_.empty();
+  Transaction t = begin();
+  const bool proposal = options_.version == FastSlamVersion::v2 && !t.pending.empty();
   constexpr std::size_t kNew = ~std::size_t{0};
-  try {
-    for (auto& particle : next) {
-      State mean = particle.x;
-      Eigen::Matrix<double, X, X> cov = Eigen::Matrix<double, X, X>::Zero();
-      for (const auto& motion : pending_) {
-        const auto p = motion_.predict(mean, motion.u, motion.dt);
-        mean = p.x;
-        cov = proposal ? Eigen::Matrix<double, X, X>(p.R) : cov;
-        if (!proposal) mean = sample(p.x, p.R);
+  std::vector<std::size_t> started(t.particles.size(), 0);
+  for (std::size_t n = 0; n < t.particles.size(); ++n) {
+    auto& particle = t.particles[n];
+    State mean = particle.x;
+    Eigen::Matrix<double, X, X> cov = Eigen::Matrix<double, X, X>::Zero();
+    for (const auto& motion : t.pending) {
+      const auto p = detail::checked_motion(motion_, mean, motion.u, motion.dt);
+      mean = proposal ? p.x : sample(p.x, p.R, t.rng);
+      if (proposal) cov = p.R;
+    }
+    std::vector<std::size_t> match(measurements.size(), kNew);
+    for (std::size_t i = 0; i < measurements.size(); ++i) {
+      double best_nis = options_.new_landmark_nis;
+      for (std::size_t j = 0; j < particle.unassociated.size(); ++j) {
+        const auto& L = particle.unassociated[j];
+        if (!L.alive) continue;
+        const auto pred = sensor_.predict(mean, L.mean);
+        const Eigen::Matrix<double, Z, Z> S = pred.J_z_x * cov * pred.J_z_x.transpose() +
+                                              pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q;
+        const double nis =
+            mahalanobis_squared(cholesky_or_throw(S, "association innovation"), sensor_.residual(measurements[i], pred.z));
+        if (nis < best_nis) best_nis = nis, match[i] = j;
       }
-      std::vector<std::size_t> match(measurements.size(), kNew);
-      for (std::size_t i = 0; i < measurements.size(); ++i) {
-        double best_nis = options_.new_landmark_nis;
-        for (std::size_t j = 0; j < particle.unassociated.size(); ++j) {
-          const auto& L = particle.unassociated[j];
-          if (!L.alive) continue;
-          const auto pred = sensor_.predict(mean, L.mean);
-          const Eigen::Matrix<double, Z, Z> S = pred.J_z_x * cov * pred.J_z_x.transpose() +
-                                                pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q;
-          const double nis =
-              mahalanobis_squared(cholesky_or_throw(S, "association innovation"), sensor_.residual(measurements[i], pred.z));
-          if (nis < best_nis) best_nis = nis, match[i] = j;
-        }
-        if (proposal && match[i] != kNew) {  // fold the associated measurement into the proposal
-          const auto& L = particle.unassociated[match[i]];
-          const auto pred = sensor_.predict(mean, L.mean);
-          const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_x * cov * pred.J_z_x.transpose() +
-                                                            pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
-          const auto llt = cholesky_or_throw(S, "proposal innovation covariance");
-          const Eigen::Matrix<double, X, Z> K = llt.solve(pred.J_z_x * cov).transpose();
-          const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(measurements[i], pred.z);
-          particle.log_weight += detail::log_gaussian(llt, nu);
-          mean = Space::plus(mean, K * nu);
-          cov = symmetrized((Eigen::Matrix<double, X, X>::Identity() - K * pred.J_z_x) * cov);
-        }
-      }
-      particle.x = proposal ? sample(mean, cov) : mean;
-      for (std::size_t i = 0; i < measurements.size(); ++i) {
-        if (match[i] != kNew) {
-          const double log_likelihood = update_landmark(particle, match[i], measurements[i], true);
-          if (!proposal) particle.log_weight += log_likelihood;
-          continue;
-        }
-        const auto init = initialize_landmark(sensor_, particle.x, measurements[i], 0);
-        particle.unassociated.push_back({init.m, symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose()), true});
-        // A new landmark weighs as a measurement on the gate's edge (the p0 of Montemerlo et al.).
-        particle.log_weight += detail::log_gaussian(cholesky_or_throw(init.Q, "measurement noise"),
-                                                    Eigen::Matrix<double, Z, 1>::Zero().eval()) -
-                               0.5 * options_.new_landmark_nis;
+      if (proposal && match[i] != kNew) {  // fold the associated measurement into the proposal
+        const auto& L = particle.unassociated[match[i]];
+        const auto pred = sensor_.predict(mean, L.mean);
+        const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_x * cov * pred.J_z_x.transpose() +
+                                                          pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
+        const auto llt = cholesky_or_throw(S, "proposal innovation covariance");
+        const Eigen::Matrix<double, X, Z> K = llt.solve(pred.J_z_x * cov).transpose();
+        const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(measurements[i], pred.z);
+        particle.log_weight += detail::log_gaussian(llt, nu);
+        mean = Space::plus(mean, K * nu);
+        cov = symmetrized((Eigen::Matrix<double, X, X>::Identity() - K * pred.J_z_x) * cov);
       }
     }
-  } catch (...) {
-    rng_ = rng_before;
-    throw;
+    particle.x = proposal ? sample(mean, cov, t.rng) : mean;
+    for (std::size_t i = 0; i < measurements.size(); ++i) {
+      if (match[i] != kNew) {
+        const double log_likelihood = update_landmark(particle, match[i], measurements[i], true);
+        if (!proposal) particle.log_weight += log_likelihood;
+        continue;
+      }
+      const LandmarkId id = t.next_unassociated_id + i;
+      const auto init = initialize_landmark(sensor_, particle.x, measurements[i], id);
+      particle.unassociated.push_back({init.m, symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose()), true, id});
+      ++started[n];
+      // A new landmark weighs as a measurement on the gate's edge (the p0 of Montemerlo et al.).
+      particle.log_weight += detail::log_gaussian(cholesky_or_throw(init.Q, "measurement noise"),
+                                                  Eigen::Matrix<double, Z, 1>::Zero().eval()) -
+                             0.5 * options_.new_landmark_nis;
+    }
   }
-  particles_ = std::move(next);
-  pending_.clear();
-  normalize_and_resample();
-  return {measurements.size(), 0, {}};
+  t.pending.clear();
+  t.next_unassociated_id += measurements.size();
+  const std::size_t initialized = started[best_particle(t.particles)];
+  normalize_and_resample(t);
+  commit(std::move(t));
+  return {measurements.size() - initialized, initialized, {}};
 }
 
-/// Normalizes the log weights (log-sum-exp) and resamples by the low-variance sampler (§3.7.4)
-/// when the effective sample size falls below the threshold.
+/// Normalizes the log weights (log-sum-exp), keeps the weighted cloud as the pose estimate, and
+/// resamples by the low-variance sampler (§3.7.4) when the effective sample size falls below the
+/// threshold.
 template <class Motion, class Sensor, template <class> class Map>
-void FastSlam<Motion, Sensor, Map>::normalize_and_resample() {
-  const double max_log = std::max_element(particles_.begin(), particles_.end(), [](const auto& a, const auto& b) {
-                           return a.log_weight < b.log_weight;
-                         })->log_weight;
+void FastSlam<Motion, Sensor, Map>::normalize_and_resample(Transaction& t) const {
+  auto& particles = t.particles;
+  const double max_log = particles[best_particle(particles)].log_weight;
+  if (!std::isfinite(max_log)) throw numerical_error("FastSLAM particle weights are not finite");
   double sum = 0.0;
-  for (const auto& p : particles_) sum += std::exp(p.log_weight - max_log);
+  for (const auto& p : particles) sum += std::exp(p.log_weight - max_log);
   const double log_total = max_log + std::log(sum);
-  for (auto& p : particles_) p.log_weight -= log_total;
-  estimate_ = cloud_estimate();
-  const double n = static_cast<double>(particles_.size());
-  if (effective_sample_size() >= options_.resample_threshold * n) return;
-  const auto w = weights();
+  for (auto& p : particles) p.log_weight -= log_total;
+  t.estimate = cloud_estimate(particles, t.pending);
+  const double n = static_cast<double>(particles.size());
+  const auto w = normalized_weights(particles);
+  double sum_sq = 0.0;
+  for (double v : w) sum_sq += v * v;
+  if (1.0 / sum_sq >= options_.resample_threshold * n) return;
   std::vector<Particle> resampled;
-  resampled.reserve(particles_.size());
+  resampled.reserve(particles.size());
   const double step = 1.0 / n;
-  double u = std::uniform_real_distribution<double>(0.0, step)(rng_), cumulative = w[0];
+  double u = std::uniform_real_distribution<double>(0.0, step)(t.rng), cumulative = w[0];
   std::size_t i = 0;
-  for (std::size_t m = 0; m < particles_.size(); ++m, u += step) {
+  for (std::size_t m = 0; m < particles.size(); ++m, u += step) {
     while (u > cumulative && i + 1 < w.size()) cumulative += w[++i];
-    resampled.push_back(particles_[i]);  // O(1) map copy with PersistentArray
+    resampled.push_back(particles[i]);  // O(1) map copy with PersistentArray
     resampled.back().log_weight = -std::log(n);
   }
-  particles_ = std::move(resampled);
-  ++resamplings_;
+  particles = std::move(resampled);
+  t.resampled = true;
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+std::vector<double> FastSlam<Motion, Sensor, Map>::normalized_weights(const std::vector<Particle>& particles) {
+  std::vector<double> w;
+  w.reserve(particles.size());
+  for (const auto& p : particles) w.push_back(std::exp(p.log_weight));
+  const double sum = std::accumulate(w.begin(), w.end(), 0.0);
+  for (double& v : w) v /= sum;
+  return w;
 }
 
 template <class Motion, class Sensor, template <class> class Map>
 std::vector<double> FastSlam<Motion, Sensor, Map>::weights() const {
-  std::vector<double> w;
-  w.reserve(particles_.size());
-  for (const auto& p : particles_) w.push_back(std::exp(p.log_weight));
-  const double sum = std::accumulate(w.begin(), w.end(), 0.0);
-  for (double& v : w) v /= sum;
-  return w;
+  return normalized_weights(particles_);
 }
 
 template <class Motion, class Sensor, template <class> class Map>
@@ -278,43 +318,58 @@ double FastSlam<Motion, Sensor, Map>::effective_sample_size() const {
 }
 
 template <class Motion, class Sensor, template <class> class Map>
-std::size_t FastSlam<Motion, Sensor, Map>::best_particle() const {
-  return static_cast<std::size_t>(std::max_element(particles_.begin(), particles_.end(),
+std::size_t FastSlam<Motion, Sensor, Map>::best_particle(const std::vector<Particle>& particles) {
+  return static_cast<std::size_t>(std::max_element(particles.begin(), particles.end(),
                                                    [](const auto& a, const auto& b) { return a.log_weight < b.log_weight; }) -
-                                  particles_.begin());
+                                  particles.begin());
 }
 
 /// Weighted mean and covariance of the poses, in the tangent space at the best particle (a pose
 /// not yet sampled by FastSLAM 2.0 counts at its predicted mean).
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::pose() const -> PoseEstimate {
-  return estimate_ ? *estimate_ : cloud_estimate();
+  return estimate_ ? *estimate_ : cloud_estimate(particles_, pending_);
 }
 
 template <class Motion, class Sensor, template <class> class Map>
-auto FastSlam<Motion, Sensor, Map>::cloud_estimate() const -> PoseEstimate {
-  const auto w = weights();
+auto FastSlam<Motion, Sensor, Map>::cloud_estimate(const std::vector<Particle>& cloud,
+                                                   const std::vector<PendingMotion>& pending) const -> PoseEstimate {
+  const auto w = normalized_weights(cloud);
   auto pose_of = [&](const Particle& p) {
     State x = p.x;
-    for (const auto& motion : pending_) x = motion_.predict(x, motion.u, motion.dt).x;
+    for (const auto& motion : pending) x = motion_.predict(x, motion.u, motion.dt).x;
     return x;
   };
-  const State reference = pose_of(particles_[best_particle()]);
+  const State reference = pose_of(cloud[best_particle(cloud)]);
   Eigen::Matrix<double, X, 1> mean_d = Eigen::Matrix<double, X, 1>::Zero();
   std::vector<Eigen::Matrix<double, X, 1>> d;
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    d.push_back(Space::minus(pose_of(particles_[i]), reference));
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    d.push_back(Space::minus(pose_of(cloud[i]), reference));
     mean_d += w[i] * d.back();
   }
   Eigen::Matrix<double, X, X> cov = Eigen::Matrix<double, X, X>::Zero();
-  for (std::size_t i = 0; i < particles_.size(); ++i) cov += w[i] * (d[i] - mean_d) * (d[i] - mean_d).transpose();
-  return {Space::plus(reference, mean_d), symmetrized(cov)};
+  for (std::size_t i = 0; i < cloud.size(); ++i) cov += w[i] * (d[i] - mean_d) * (d[i] - mean_d).transpose();
+  PoseEstimate out{Space::plus(reference, mean_d), symmetrized(cov)};
+  if (!Space::is_finite(out.mean) || !out.cov.allFinite()) throw numerical_error("FastSLAM cloud pose estimate is not finite");
+  return out;
+}
+
+/// A landmark that the most likely particle created by its own association, if it has `id`.
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::unassociated_landmark(LandmarkId id) const -> std::optional<LandmarkEstimate<M>> {
+  const auto& map = particles_[best_particle()].unassociated;
+  for (std::size_t j = 0; j < map.size(); ++j)
+    if (map[j].alive && map[j].id == id) return LandmarkEstimate<M>{id, map[j].mean, map[j].cov};
+  return std::nullopt;
 }
 
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::landmark(LandmarkId id) const -> LandmarkEstimate<M> {
   const auto it = index_.find(id);
-  if (it == index_.end()) throw unknown_landmark_error("unknown landmark id " + std::to_string(id));
+  if (it == index_.end()) {
+    if (auto found = unassociated_landmark(id)) return *found;
+    throw unknown_landmark_error("unknown landmark id " + std::to_string(id));
+  }
   if (options_.map_estimate == FastSlamMap::best_particle) {
     const auto& L = particles_[best_particle()].landmarks[it->second];
     return {id, L.mean, L.cov};
@@ -330,28 +385,61 @@ auto FastSlam<Motion, Sensor, Map>::landmark(LandmarkId id) const -> LandmarkEst
   return {id, mean, symmetrized(cov)};
 }
 
+/// The known landmarks (per options().map_estimate), then those the most likely particle created
+/// by its own association (their correspondence differs between particles, so they are not averaged).
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::map() const -> MapEstimate {
   MapEstimate out;
-  for (LandmarkId id : landmark_ids()) out.push_back(landmark(id));
+  for (std::size_t index = 0; index < id_of_index_.size(); ++index)
+    if (is_current(index)) out.push_back(landmark(id_of_index_[index]));
+  const auto& own = particles_[best_particle()].unassociated;
+  for (std::size_t j = 0; j < own.size(); ++j)
+    if (own[j].alive) out.push_back({own[j].id, own[j].mean, own[j].cov});
   return out;
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+bool FastSlam<Motion, Sensor, Map>::has_landmark(LandmarkId id) const {
+  return index_.contains(id) || unassociated_landmark(id).has_value();
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+std::size_t FastSlam<Motion, Sensor, Map>::num_landmarks() const {
+  const auto& own = particles_[best_particle()].unassociated;
+  std::size_t alive = 0;
+  for (std::size_t j = 0; j < own.size(); ++j) alive += own[j].alive;
+  return index_.size() + alive;
 }
 
 template <class Motion, class Sensor, template <class> class Map>
 std::vector<LandmarkId> FastSlam<Motion, Sensor, Map>::landmark_ids() const {
   std::vector<LandmarkId> out;
-  for (LandmarkId id : id_of_index_)
-    if (index_.contains(id)) out.push_back(id);
+  for (const auto& landmark : map()) out.push_back(landmark.id);
   return out;
 }
 
-/// Forgets a landmark in every particle (its index is not reused).
+/// Forgets a landmark in every particle. A known id's index is not reused: observed again, the id
+/// starts afresh at a new index.
 template <class Motion, class Sensor, template <class> class Map>
 void FastSlam<Motion, Sensor, Map>::remove_landmark(LandmarkId id) {
-  const auto it = index_.find(id);
-  if (it == index_.end()) throw unknown_landmark_error("unknown landmark id " + std::to_string(id));
-  for (auto& particle : particles_) particle.landmarks.mutate(it->second).alive = false;
-  index_.erase(it);
+  if (const auto it = index_.find(id); it != index_.end()) {
+    auto particles = particles_;
+    for (auto& particle : particles) particle.landmarks.mutate(it->second).alive = false;
+    particles_.swap(particles);
+    index_.erase(it);
+    return;
+  }
+  auto particles = particles_;
+  bool found = false;
+  for (auto& particle : particles)
+    for (std::size_t j = 0; j < particle.unassociated.size(); ++j)
+      if (particle.unassociated[j].id == id && particle.unassociated[j].alive) {
+        particle.unassociated.mutate(j).alive = false;
+        found = true;
+      }
+  if (!found) throw unknown_landmark_error("unknown landmark id " + std::to_string(id));
+  particles_.swap(particles);
+  estimate_.reset();
 }
 
 }  // namespace sextant

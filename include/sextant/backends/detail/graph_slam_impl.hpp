@@ -66,7 +66,7 @@ struct GraphSlam<Motion, Sensor>::Linearization {
 
 template <class Motion, class Sensor>
 GraphSlam<Motion, Sensor>::GraphSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, GraphOptions options)
-    : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), prior_(prior) {
+    : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), prior_(prior), newest_cov_(prior.cov) {
   if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
   prior_information_ = symmetrized(
       cholesky_or_throw(prior.cov, "prior covariance").solve(Eigen::Matrix<double, X, X>::Identity()));
@@ -82,9 +82,16 @@ void GraphSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   const auto prediction = motion_.predict(poses_.back(), u, dt);
   if (!Space::is_finite(prediction.x) || !prediction.J_x_x.allFinite() || !prediction.R.allFinite())
     throw numerical_error("motion model returned NaN or Inf");
-  cholesky_or_throw(prediction.R, "process noise R of step " + std::to_string(motions_.size()));
+  require_process_noise(prediction.R);
+  if constexpr (!HasBetweenFactor<Motion>)  // the motion factor is weighted by R^-1
+    cholesky_or_throw(prediction.R, "process noise R of step " + std::to_string(motions_.size()) +
+                                        " (GraphSLAM weights the motion factor by R^-1)");
+  const Eigen::Matrix<double, X, X> newest_cov =
+      symmetrized(prediction.J_x_x * newest_cov_ * prediction.J_x_x.transpose() + prediction.R);
+  if (!newest_cov.allFinite()) throw numerical_error("GraphSLAM: covariance of the new pose overflowed");
   motions_.push_back({u, dt});
   poses_.push_back(prediction.x);
+  newest_cov_ = newest_cov;
   touch();
 }
 
@@ -290,17 +297,46 @@ Eigen::VectorXd GraphSlam<Motion, Sensor>::solve(const Linearization& sys, doubl
     for (auto& terms : damped.landmarks) terms.diagonal.diagonal() *= 1.0 + lambda;
     system = &damped;
   }
-  bool schur = options_.solver == GraphSolver::landmark_schur;
-  if (options_.solver == GraphSolver::automatic)
-    schur = M * system->landmarks.size() > X * system->pose_count;
-  return schur ? solve_by_landmark_schur(*system, summary) : solve_full(*system, summary);
+  return uses_landmark_schur(*system) ? solve_by_landmark_schur(*system, summary) : solve_full(*system, summary);
+}
+
+template <class Motion, class Sensor>
+bool GraphSlam<Motion, Sensor>::uses_landmark_schur(const Linearization& sys) const {
+  if (options_.solver == GraphSolver::automatic) return M * sys.landmarks.size() > X * sys.pose_count;
+  return options_.solver == GraphSolver::landmark_schur;
+}
+
+/// The marginal covariance of the newest pose at the linearization `sys`: X solves with the
+/// Cholesky factor of the information matrix (or of its Schur complement on the poses, whose
+/// inverse is the poses' marginal covariance). One numeric factorization, no selected inversion.
+template <class Motion, class Sensor>
+auto GraphSlam<Motion, Sensor>::newest_pose_marginal(const Linearization& sys) -> Eigen::Matrix<double, X, X> {
+  OptimizationSummary ignored;
+  solve(sys, 0.0, ignored);  // factorizes the undamped system
+  const Eigen::Index dim = uses_landmark_schur(sys) ? X * static_cast<Eigen::Index>(sys.pose_count) : sys.dim();
+  const Eigen::Index at = X * static_cast<Eigen::Index>(sys.pose_count - 1);
+  Eigen::Matrix<double, X, X> out;
+  for (int i = 0; i < X; ++i) {
+    Eigen::VectorXd unit = Eigen::VectorXd::Zero(dim);
+    unit(at + i) = 1.0;
+    out.col(i) = solver_.solve(unit).template segment<X>(at);
+  }
+  out = symmetrized(out);
+  if (!out.allFinite()) throw numerical_error("GraphSLAM: marginal covariance of the newest pose is not finite");
+  return out;
 }
 
 /// Gauss-Newton (or Levenberg-Marquardt) until the step or the relative change of chi2 is small.
 template <class Motion, class Sensor>
-OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_count, int max_iterations) {
+OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_count, int max_iterations,
+                                                            Linearization* final_system) {
   using Clock = std::chrono::steady_clock;
   OptimizationSummary summary;
+  const auto began = Clock::now();
+  auto record_cost = [&](double cost) {
+    summary.cost.push_back(cost);
+    summary.seconds.push_back(std::chrono::duration<double>(Clock::now() - began).count());
+  };
   auto timed_linearize = [&] {
     const auto start = Clock::now();
     auto sys = linearize(pose_count);
@@ -308,7 +344,7 @@ OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_cou
     return sys;
   };
   Linearization sys = timed_linearize();
-  summary.cost.push_back(sys.cost);
+  record_cost(sys.cost);
   double lambda = options_.levenberg_marquardt ? options_.initial_lambda : 0.0;
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
     const Eigen::VectorXd delta = solve(sys, lambda, summary);
@@ -322,11 +358,11 @@ OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_cou
       poses_ = poses_before;
       landmark_means_ = means_before;
       lambda *= 10.0;
-      summary.cost.push_back(sys.cost);
+      record_cost(sys.cost);
       continue;
     }
     if (lambda > 0.0) lambda = std::max(lambda / 10.0, 1e-12);
-    summary.cost.push_back(next.cost);
+    record_cost(next.cost);
     const double previous = sys.cost;
     sys = std::move(next);
     const double step = delta.size() ? delta.cwiseAbs().maxCoeff() : 0.0;
@@ -336,6 +372,7 @@ OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_cou
       break;
     }
   }
+  if (final_system) *final_system = std::move(sys);
   return summary;
 }
 
@@ -368,14 +405,19 @@ template <class Motion, class Sensor>
 OptimizationSummary GraphSlam<Motion, Sensor>::optimize() {
   const std::vector<State> poses_before = poses_;
   const Eigen::VectorXd means_before = landmark_means_;
+  const bool windows_done_before = windows_done_;
   try {
     if (options_.window > 0 && !windows_done_) initialize_in_windows();
-    OptimizationSummary summary = gauss_newton(poses_.size(), options_.max_iterations);
+    Linearization final_system;
+    OptimizationSummary summary = gauss_newton(poses_.size(), options_.max_iterations, &final_system);
+    newest_cov_ = newest_pose_marginal(final_system);
     touch();
     return summary;
   } catch (...) {
     poses_ = poses_before;
     landmark_means_ = means_before;
+    windows_done_ = windows_done_before;
+    touch();
     throw;
   }
 }
@@ -440,34 +482,24 @@ void GraphSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
 }
 
 template <class Motion, class Sensor>
-const SelectedInverse& GraphSlam<Motion, Sensor>::marginals() const {
-  if (!marginals_ || marginals_revision_ != revision_) {
-    marginals_ = std::make_shared<const SelectedInverse>(linearize(poses_.size()).assemble());
-    marginals_revision_ = revision_;
-  }
-  return *marginals_;
+std::shared_ptr<const SelectedInverse> GraphSlam<Motion, Sensor>::marginals() const {
+  return marginals_.get(revision_, [&] { return std::make_shared<const SelectedInverse>(linearize(poses_.size()).assemble()); });
 }
 
 template <class Motion, class Sensor>
 auto GraphSlam<Motion, Sensor>::trajectory() const -> std::vector<PoseEstimate> {
-  const auto& Z_ = marginals();
+  const auto marginals = this->marginals();
   std::vector<PoseEstimate> out;
   out.reserve(poses_.size());
-  for (std::size_t p = 0; p < poses_.size(); ++p) out.push_back({poses_[p], Z_.block(X * p, X)});
+  for (std::size_t p = 0; p < poses_.size(); ++p) out.push_back({poses_[p], marginals->block(X * p, X)});
   return out;
-}
-
-template <class Motion, class Sensor>
-auto GraphSlam<Motion, Sensor>::pose() const -> PoseEstimate {
-  const std::size_t p = poses_.size() - 1;
-  return {poses_[p], marginals().block(X * p, X)};
 }
 
 template <class Motion, class Sensor>
 auto GraphSlam<Motion, Sensor>::landmark(LandmarkId id) const -> LandmarkEstimate<M> {
   const std::size_t slot = pool_.slot(id);
   const Eigen::Index at = X * static_cast<Eigen::Index>(poses_.size()) + M * static_cast<Eigen::Index>(slot);
-  return {id, landmark_mean(slot), marginals().block(at, M)};
+  return {id, landmark_mean(slot), marginals()->block(at, M)};
 }
 
 template <class Motion, class Sensor>

@@ -36,6 +36,7 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   const auto prediction = motion_.predict(x_, u, dt);
   if (!Space::is_finite(prediction.x) || !prediction.J_x_x.allFinite() || !prediction.R.allFinite())
     throw numerical_error("motion model returned NaN or Inf");
+  require_process_noise(prediction.R);
   const auto singular_values = Eigen::JacobiSVD<MatrixX>(prediction.J_x_x).singularValues();
   if (!(singular_values(X - 1) > 1e-12 * singular_values(0)))
     throw numerical_error("motion Jacobian G is singular; the SEIF motion update needs G^-1");
@@ -49,19 +50,22 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   for (const auto& [slot, block] : info_.robot_links()) Phi_x.emplace_back(slot, G_inv_T * block);
   const Eigen::Matrix<double, X, 1> r_x = G_inv_T * info_.robot_residual();
 
-  info_.robot() = symmetrized(A * Phi_xx);
-  info_.robot_residual() = A * r_x;
-  const Eigen::Matrix<double, X, 1> T_r_x = T * r_x;
-  for (std::size_t a = 0; a < Phi_x.size(); ++a) {
-    const auto& [i, Phi_xi] = Phi_x[a];
-    info_.set_robot_link(i, A * Phi_xi);
-    const Eigen::Matrix<double, M, X> Phi_ix_T = Phi_xi.transpose() * T;
-    info_.diagonal(i) = symmetrized(info_.diagonal(i) - Phi_ix_T * Phi_xi);
-    info_.landmark_residual(i) -= Phi_xi.transpose() * T_r_x;
-    for (std::size_t b = a + 1; b < Phi_x.size(); ++b) info_.add_to_link(i, Phi_x[b].first, -Phi_ix_T * Phi_x[b].second);
-  }
-  x_ = prediction.x;
-  touch();
+  atomically([&] {
+    info_.robot() = symmetrized(A * Phi_xx);
+    info_.robot_residual() = A * r_x;
+    const Eigen::Matrix<double, X, 1> T_r_x = T * r_x;
+    for (std::size_t a = 0; a < Phi_x.size(); ++a) {
+      const auto& [i, Phi_xi] = Phi_x[a];
+      info_.set_robot_link(i, A * Phi_xi);
+      const Eigen::Matrix<double, M, X> Phi_ix_T = Phi_xi.transpose() * T;
+      info_.diagonal(i) = symmetrized(info_.diagonal(i) - Phi_ix_T * Phi_xi);
+      info_.landmark_residual(i) -= Phi_xi.transpose() * T_r_x;
+      for (std::size_t b = a + 1; b < Phi_x.size(); ++b)
+        info_.add_to_link(i, Phi_x[b].first, -Phi_ix_T * Phi_x[b].second);
+    }
+    x_ = prediction.x;
+    require_finite_robot_and_active("SEIF motion update");
+  });
 }
 
 /// H^T Q^-1 H and H^T Q^-1 nu of one observation, by blocks (thesis eqs. 29-30).
@@ -120,7 +124,7 @@ template <class Motion, class Sensor>
 UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
   require_valid_observations(observations);
   const auto [known, fresh] = split_known_and_new(pool_, observations);
-  // Everything that can throw on bad input, before the state changes.
+  // Linearize everything first; the rest runs as one transaction, undone if any step throws.
   std::vector<MeasurementInformation> measurements;
   measurements.reserve(known.size());
   for (const auto& observation : known) measurements.push_back(measurement_information(observation));
@@ -128,25 +132,72 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
   landmarks.reserve(fresh.size());
   for (const auto& observation : fresh) landmarks.push_back(new_landmark(observation));
 
-  std::vector<std::size_t> observed;
-  for (const auto& info : measurements) {
-    add(info);
-    observed.push_back(info.slot);
-  }
-  for (const auto& landmark : landmarks) {
-    augment(landmark);
-    observed.push_back(pool_.size() - 1);
-  }
-  touch();
-  ++updates_;
-  if (options_.exact_recovery_period > 0 && updates_ % static_cast<std::uint64_t>(options_.exact_recovery_period) == 0)
-    recover_mean_exactly();
-  else
-    recover_mean_locally();
-  update_active_queue(observed);
-  sparsify();
-  touch();
+  atomically([&] {
+    std::vector<std::size_t> observed;
+    for (const auto& info : measurements) {
+      add(info);
+      observed.push_back(info.slot);
+    }
+    for (const auto& landmark : landmarks) {
+      augment(landmark);
+      observed.push_back(pool_.size() - 1);
+    }
+    ++updates_;
+    if (options_.exact_recovery_period > 0 && updates_ % static_cast<std::uint64_t>(options_.exact_recovery_period) == 0)
+      recover_mean_exactly_in_transaction();
+    else
+      recover_mean_locally();
+    update_active_queue(observed);
+    sparsify();
+    require_finite_robot_and_active("SEIF update");
+  });
   return {known.size(), fresh.size(), {}};
+}
+
+/// Runs `step` so that it either completes or, if it throws, leaves the filter exactly as before:
+/// the information form is journaled block by block, the means that move are saved first.
+template <class Motion, class Sensor>
+template <class Step>
+void SeifSlam<Motion, Sensor>::atomically(Step step) {
+  Undo undo{x_, {}, {}, active_queue_, updates_, pool_.size()};
+  undo_ = &undo;
+  info_.begin_transaction();
+  try {
+    step();
+    info_.commit();
+    undo_ = nullptr;
+    touch();
+  } catch (...) {
+    info_.rollback();
+    undo_ = nullptr;
+    while (pool_.size() > undo.landmarks) pool_.remove(pool_.id_at(pool_.size() - 1));
+    if (undo.all_means) landmark_means_ = std::move(*undo.all_means);
+    landmark_means_.conservativeResize(M * static_cast<Eigen::Index>(undo.landmarks));
+    for (auto it = undo.means.rbegin(); it != undo.means.rend(); ++it)  // oldest saved value last
+      landmark_means_.template segment<M>(M * it->first) = it->second;
+    x_ = undo.x;
+    active_queue_ = std::move(undo.active_queue);
+    updates_ = undo.updates;
+    touch();  // a new version, never an old one: caches may not mistake anything for the old state
+    throw;
+  }
+}
+
+/// mu_m += dm, remembering the old mean inside a transaction.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::move_landmark_mean(std::size_t slot, const Eigen::Matrix<double, M, 1>& dm) {
+  if (undo_ && slot < undo_->landmarks && !undo_->all_means) undo_->means.emplace_back(slot, landmark_mean(slot));
+  landmark_means_.template segment<M>(M * slot) += dm;
+}
+
+/// Overflow shows up first in the blocks a step touched: the robot's and the active landmarks'.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::require_finite_robot_and_active(const char* what) const {
+  bool finite = info_.robot().allFinite() && info_.robot_residual().allFinite() && Space::is_finite(x_);
+  for (const auto& [slot, block] : info_.robot_links())
+    finite = finite && block.allFinite() && info_.diagonal(slot).allFinite() && info_.landmark_residual(slot).allFinite() &&
+             landmark_mean(slot).allFinite();
+  if (!finite) throw numerical_error(std::string(what) + ": the information form overflowed (NaN or Inf)");
 }
 
 template <class Motion, class Sensor>
@@ -192,7 +243,7 @@ void SeifSlam<Motion, Sensor>::recover_mean_of_active_block() {
   std::unordered_set<std::size_t> in_block(slots.begin(), slots.end());
   for (std::size_t a = 0; a < slots.size(); ++a) {
     const Eigen::Matrix<double, M, 1> dm = delta.template segment<M>(X + M * a);
-    landmark_means_.template segment<M>(M * slots[a]) += dm;
+    move_landmark_mean(slots[a], dm);
     info_.landmark_residual(slots[a]) = r_after.template segment<M>(X + M * a);
     for (const auto& [neighbour, block] : info_.links(slots[a]))
       if (!in_block.contains(neighbour)) info_.landmark_residual(neighbour) -= block.transpose() * dm;
@@ -214,7 +265,7 @@ void SeifSlam<Motion, Sensor>::recover_mean_by_coordinate_descent() {
     for (const auto& [slot, block] : info_.robot_links()) info_.landmark_residual(slot) -= block.transpose() * dx;
     for (const auto& [slot, llt] : active) {
       const Eigen::Matrix<double, M, 1> dm = llt.solve(info_.landmark_residual(slot));
-      landmark_means_.template segment<M>(M * slot) += dm;
+      move_landmark_mean(slot, dm);
       info_.landmark_residual(slot) -= info_.diagonal(slot) * dm;
       info_.robot_residual() -= info_.robot_link(slot) * dm;
       for (const auto& [neighbour, block] : info_.links(slot)) info_.landmark_residual(neighbour) -= block.transpose() * dm;
@@ -224,16 +275,21 @@ void SeifSlam<Motion, Sensor>::recover_mean_by_coordinate_descent() {
 
 template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::recover_mean_exactly() {
+  atomically([&] { recover_mean_exactly_in_transaction(); });
+}
+
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::recover_mean_exactly_in_transaction() {
   const Eigen::SparseMatrix<double> omega = info_.to_sparse();
   const Factor factor(omega);
   if (factor.info() != Eigen::Success) throw numerical_error("information matrix is not positive definite");
   const Eigen::VectorXd r = info_.residual();
   const Eigen::VectorXd delta = factor.solve(r);
   if (!delta.allFinite()) throw numerical_error("exact mean recovery is not finite");
+  if (undo_ && !undo_->all_means) undo_->all_means = landmark_means_;
   x_ = Space::plus(x_, delta.template head<X>());
   landmark_means_ += delta.tail(delta.size() - X);
   info_.set_residual(r - omega * delta);
-  touch();
 }
 
 /// The thesis's queue (§3.5.4): landmarks observed now first, then the previously active ones in
@@ -324,13 +380,10 @@ void SeifSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
 }
 
 template <class Motion, class Sensor>
-auto SeifSlam<Motion, Sensor>::factorization() const -> const Factor& {
-  if (!factor_ || factor_revision_ != revision_) {
-    factor_ = std::make_shared<const Factor>(info_.to_sparse());
-    factor_revision_ = revision_;
-  }
-  if (factor_->info() != Eigen::Success) throw numerical_error("information matrix is not positive definite");
-  return *factor_;
+auto SeifSlam<Motion, Sensor>::factorization() const -> std::shared_ptr<const Factor> {
+  auto factor = factor_.get(revision_, [&] { return std::make_shared<const Factor>(info_.to_sparse()); });
+  if (factor->info() != Eigen::Success) throw numerical_error("information matrix is not positive definite");
+  return factor;
 }
 
 /// A diagonal block of Omega^-1 from `size` sparse solves.
@@ -338,7 +391,7 @@ template <class Motion, class Sensor>
 Eigen::MatrixXd SeifSlam<Motion, Sensor>::marginal_covariance(Eigen::Index offset, Eigen::Index size) const {
   Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(state_dim(), size);
   unit.block(offset, 0, size, size).setIdentity();
-  const Eigen::MatrixXd columns = factorization().solve(unit);
+  const Eigen::MatrixXd columns = factorization()->solve(unit);
   return symmetrized(columns.block(offset, 0, size, size));
 }
 
@@ -358,11 +411,12 @@ auto SeifSlam<Motion, Sensor>::map() const -> MapEstimate {
   MapEstimate out;
   out.reserve(pool_.size());
   constexpr std::size_t kChunk = 32;  // landmarks per multi-right-hand-side solve
+  const auto factor = factorization();
   for (std::size_t first = 0; first < pool_.size(); first += kChunk) {
     const std::size_t count = std::min(kChunk, pool_.size() - first);
     Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(state_dim(), M * static_cast<Eigen::Index>(count));
     unit.block(offset_of(first), 0, unit.cols(), unit.cols()).setIdentity();
-    const Eigen::MatrixXd columns = factorization().solve(unit);
+    const Eigen::MatrixXd columns = factor->solve(unit);
     for (std::size_t k = 0; k < count; ++k)
       out.push_back({pool_.id_at(first + k), landmark_mean(first + k),
                      symmetrized(columns.template block<M, M>(offset_of(first + k), M * k))});

@@ -1,0 +1,55 @@
+#pragma once
+// What one data set's part of the run does, for any data set type: run the chosen back-ends, print
+// their rows, write their files. Included by the translation units that instantiate it, one per
+// data-set family (run_ship.cpp, run_planar_rawlog.cpp, run_spatial_rawlog.cpp), which a build on
+// several cores compiles side by side.
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "dataset_runs.hpp"
+#include "experiments.hpp"
+#include "run_outputs.hpp"
+
+namespace sextant::runner {
+
+inline std::string directory_name(const std::string& dataset) {
+  return dataset == "ship" ? "ship" : std::filesystem::path(dataset).stem().string();
+}
+
+/// Writes the files of every run of one data set and, if asked, the plots.
+template <class Dataset>
+void write_dataset_outputs(const RunOptions& options, const std::string& dataset, const Dataset& data,
+                           const std::vector<std::pair<BackendKind, BackendRun<Dataset>>>& runs, const Scoring& scoring,
+                           const RunnerConfig& config, const char* unit) {
+  if (options.out.empty()) return;
+  const auto dir = std::filesystem::path(options.out) / directory_name(dataset);
+  for (const auto& [kind, run] : runs) write_run_outputs(dir, kind, run, data, scoring, config);
+  std::printf("wrote per-step CSV, map CSV, TUM trajectories and .3Dscene files to %s\n", dir.c_str());
+  if (!options.plots) return;
+  const auto script = std::filesystem::canonical("/proc/self/exe").parent_path() / "plot_run.py";
+  // Debian's interpreter (where python3-matplotlib installs) before whatever python3 is first on PATH.
+  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  const std::string command = python + " '" + script.string() + "' '" + dir.string() + "' " + unit;
+  if (std::system(command.c_str()) != 0)
+    throw error(dir.string() + ": plotting failed (needs python3 with matplotlib: Debian python3-matplotlib)");
+  std::printf("wrote plots (PNG) to %s\n", dir.c_str());
+}
+
+/// Runs the chosen back-ends on one data set, prints its part of the table, writes its outputs.
+template <class Dataset>
+std::vector<TableRow> run_dataset(const RunOptions& options, const std::string& name, const Dataset& data,
+                                  const std::vector<BackendKind>& kinds, const RunnerConfig& config,
+                                  const Scoring& scoring, const char* unit) {
+  std::printf("\n== %s: %zu steps, %zu landmarks in the ground truth; errors in %s\n", name.c_str(), data.steps.size(),
+              data.true_landmarks.size(), unit);
+  print_header();
+  std::vector<std::pair<BackendKind, BackendRun<Dataset>>> runs;
+  auto rows = run_on_rawlog(name, data, kinds, config, scoring, runs);
+  for (const auto& row : rows) print_row(row);
+  write_dataset_outputs(options, name, data, runs, scoring, config, unit);
+  return rows;
+}
+
+}  // namespace sextant::runner

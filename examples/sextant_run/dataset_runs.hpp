@@ -1,0 +1,29 @@
+#pragma once
+// The runner's data-set runs, each compiled in its own translation unit.
+#include <sextant/mrpt/rawlog.hpp>
+#include <string>
+#include <vector>
+
+#include "runner_config.hpp"
+#include "table.hpp"
+
+namespace sextant::runner {
+
+/// Where and what to write besides the table.
+struct RunOptions {
+  std::string out;     ///< directory for per-run files; empty: none
+  bool plots = false;  ///< also PNG plots
+};
+
+/// The simulated ship, config.ship_runs Monte Carlo runs (run_ship.cpp).
+std::vector<TableRow> run_ship(const RunOptions& options, const std::vector<BackendKind>& kinds, const RunnerConfig& config);
+/// A planar rawlog with its ground truth attached (run_planar_rawlog.cpp).
+std::vector<TableRow> run_rawlog_dataset(const RunOptions& options, const std::string& name,
+                                         const mrpt_io::RawlogDataset2D& data, const std::vector<BackendKind>& kinds,
+                                         const RunnerConfig& config);
+/// A spatial (6D) rawlog with its ground truth attached (run_spatial_rawlog.cpp).
+std::vector<TableRow> run_rawlog_dataset(const RunOptions& options, const std::string& name,
+                                         const mrpt_io::RawlogDataset3D& data, const std::vector<BackendKind>& kinds,
+                                         const RunnerConfig& config);
+
+}  // namespace sextant::runner

@@ -1,0 +1,100 @@
+#pragma once
+// The comparison table's rows: which back-end, with what settings, and its scores; printing them and
+// writing them as JSON. Light: no back-end is instantiated here.
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <sextant/eval/experiment.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "runner_config.hpp"
+
+namespace sextant::runner {
+
+enum class BackendKind { ekf, seif, graph, fastslam1, fastslam2 };
+
+inline const std::vector<BackendKind>& all_backends() {
+  static const std::vector<BackendKind> all = {BackendKind::ekf, BackendKind::seif, BackendKind::graph,
+                                               BackendKind::fastslam1, BackendKind::fastslam2};
+  return all;
+}
+
+/// The command-line name of a back-end (also the prefix of its output files).
+inline std::string backend_key(BackendKind kind) {
+  switch (kind) {
+    case BackendKind::ekf: return "ekf";
+    case BackendKind::seif: return "seif";
+    case BackendKind::graph: return "graph";
+    case BackendKind::fastslam1: return "fastslam1";
+    case BackendKind::fastslam2: return "fastslam2";
+  }
+  return "?";
+}
+
+/// The table's name of a back-end with its main setting.
+inline std::string backend_label(BackendKind kind, const RunnerConfig& c) {
+  switch (kind) {
+    case BackendKind::ekf: return "EKF-SLAM";
+    case BackendKind::seif:
+      return c.seif.max_active ? "SEIF-SLAM, " + std::to_string(c.seif.max_active) + " active" : "SEIF-SLAM, all active";
+    case BackendKind::graph: return "GraphSLAM";
+    case BackendKind::fastslam1: return "FastSLAM 1.0, " + std::to_string(c.fastslam.particles) + " particles";
+    case BackendKind::fastslam2: return "FastSLAM 2.0, " + std::to_string(c.fastslam.particles) + " particles";
+  }
+  return "?";
+}
+
+/// How a data set is scored: which pose entries are position, the degrees of freedom for NEES.
+struct Scoring {
+  int position_dim, pose_dof, landmark_dof;
+};
+
+/// A line of the comparison table.
+struct TableRow {
+  std::string dataset, backend, label;
+  eval::Summary summary;
+  int runs = 1;
+};
+
+/// The table's header line; the README's results table must show the same (tests/mrpt/runner_cli_test).
+inline void print_header() {
+  std::printf("%-29s %10s %10s %10s %10s %13s %12s %11s %10s %13s\n", "back-end", "pose MAE", "aligned", "map MAE",
+              "aligned", "pose NEES in", "map NEES in", "pose ANEES", "total [s]", "per step[us]");
+}
+
+inline void print_row(const TableRow& row) {
+  const auto& s = row.summary;
+  std::printf("%-29s %10.4g %10.4g %10.4g %10.4g %12.1f%% %11.1f%% %11.4g %10.4f %13.1f\n", row.label.c_str(), s.pose_mae,
+              s.pose_mae_aligned, s.map_mae, s.map_mae_aligned, 100.0 * s.pose_nees_inside, 100.0 * s.map_nees_inside,
+              s.pose_anees, s.total_seconds, 1e6 * s.seconds_per_step);
+}
+
+inline std::string json_number(double x) {
+  if (!std::isfinite(x)) return "null";
+  std::ostringstream out;
+  out << std::setprecision(10) << x;
+  return out.str();
+}
+
+/// The table as JSON: one object per row.
+inline void write_summary_json(const std::string& path, const std::vector<TableRow>& rows) {
+  std::ofstream out(path);
+  if (!out) throw error("cannot open " + path + " for writing");
+  out << std::setprecision(10) << "[\n";
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& s = rows[i].summary;
+    out << "  {\"dataset\": \"" << rows[i].dataset << "\", \"backend\": \"" << rows[i].backend << "\", \"label\": \""
+        << rows[i].label << "\", \"runs\": " << rows[i].runs << ", \"pose_mae\": " << json_number(s.pose_mae)
+        << ", \"map_mae\": " << json_number(s.map_mae) << ", \"pose_mae_aligned\": " << json_number(s.pose_mae_aligned)
+        << ", \"map_mae_aligned\": " << json_number(s.map_mae_aligned) << ", \"pose_nees_inside\": " << json_number(s.pose_nees_inside)
+        << ", \"map_nees_inside\": " << json_number(s.map_nees_inside) << ", \"pose_anees\": " << json_number(s.pose_anees)
+        << ", \"total_seconds\": " << json_number(s.total_seconds)
+        << ", \"seconds_per_step\": " << json_number(s.seconds_per_step) << "}" << (i + 1 < rows.size() ? ",\n" : "\n");
+  }
+  out << "]\n";
+}
+
+}  // namespace sextant::runner
