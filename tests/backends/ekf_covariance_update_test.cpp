@@ -1,6 +1,6 @@
 // The two covariance corrections of EkfSlam: the symmetric form of eq. 17 and the Joseph form.
 // On a well-conditioned problem they agree; on an ill-conditioned one (landmarks known to 1e4 m,
-// then measured to 1e-8 m) the symmetric form cancels to a covariance with negative eigenvalues
+// then observed with sigma 1e-8 m) the symmetric form cancels to a covariance with negative eigenvalues
 // while the Joseph form stays positive semi-definite.
 #include <gtest/gtest.h>
 

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/temp_path.hpp"
+
 #include <filesystem>
 #include <fstream>
 
@@ -9,7 +11,7 @@ namespace sextant::io {
 namespace {
 
 std::string write_file(const std::string& name, const std::string& text) {
-  const auto path = (std::filesystem::temp_directory_path() / ("sextant_isam_" + name + ".txt")).string();
+  const auto path = test::unique_temp_path("isam_" + name + ".txt").string();
   std::ofstream(path) << text;
   return path;
 }
@@ -79,7 +81,16 @@ INSTANTIATE_TEST_SUITE_P(
         Malformed{"old_pose", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 0 2 1 0 10 0 10\n", "newest pose is 1"},
         Malformed{"singular", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 1 2 1 0 0 50 0 0 0 0 100\n", "singular"},
         Malformed{"noise", "LANDMARK 0 1 1 0 10 0 10\nLANDMARK 0 2 1 0 20 0 20\n", "landmark noise differs"},
-        Malformed{"twice", "LANDMARK 0 1 1 0 10 0 10\nLANDMARK 0 1 1 0 10 0 10\n", "seen twice"}),
+        Malformed{"twice", "LANDMARK 0 1 1 0 10 0 10\nLANDMARK 0 1 1 0 10 0 10\n", "seen twice"},
+        // Identifiers that a cast from double would truncate or make undefined (issue 15's UBSan finding).
+        Malformed{"huge_landmark_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 1 6.1e19 1 0 10 0 10\n",
+                  "landmark id must be a non-negative integer below 2^53"},
+        Malformed{"negative_pose_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 -1 2 1 0 0 50 0 0 50 0 100\n",
+                  "pose id must be a non-negative integer"},
+        Malformed{"huge_pose_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 1e30 2 1 0 10 0 10\n",
+                  "pose id must be a non-negative integer"},
+        Malformed{"fractional_pose_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 1.7 2 1 0 0 50 0 0 50 0 100\n",
+                  "pose id must be a non-negative integer"}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(IsamReader, MissingOrEmptyFile) {

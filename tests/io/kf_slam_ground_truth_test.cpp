@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/temp_path.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -11,8 +13,7 @@ namespace {
 
 class GroundTruthFile : public ::testing::Test {
  protected:
-  std::filesystem::path path = std::filesystem::temp_directory_path() /
-                               ("sextant_gt_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+  std::filesystem::path path = test::unique_temp_path("gt_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
   void TearDown() override { std::filesystem::remove(path); }
   std::string error_of(const std::function<void()>& read) {
     try {
@@ -46,6 +47,10 @@ TEST_F(GroundTruthFile, BadRowsNameFileAndLine) {
   EXPECT_NE(error_of([&] { read_kf_slam_landmarks<2>(p); }).find(p + ":2: landmark 4 appears twice"), std::string::npos);
   std::ofstream(p) << "1 2 0 5 0 0 -1\n";
   EXPECT_NE(error_of([&] { read_kf_slam_landmarks<2>(p); }).find("non-negative integer"), std::string::npos);
+  for (const char* id : {"6.1e19", "1e30", "2.5"}) {  // issue 15: out of range or fractional ids
+    std::ofstream(p) << "1 2 0 5 0 0 " << id << "\n";
+    EXPECT_NE(error_of([&] { read_kf_slam_landmarks<2>(p); }).find("non-negative integer below 2^53"), std::string::npos) << id;
+  }
   std::ofstream(p) << "% nothing\n";
   EXPECT_NE(error_of([&] { read_kf_slam_landmarks<2>(p); }).find("no landmarks"), std::string::npos);
   EXPECT_NE(error_of([&] { read_kf_slam_path(p + ".missing"); }).find("cannot open file"), std::string::npos);

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include "support/temp_path.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -18,7 +20,7 @@ std::string read_all(const std::filesystem::path& path) {
 }
 
 TEST(CsvWriter, WritesHeaderAndRows) {
-  const auto path = std::filesystem::temp_directory_path() / "sextant_csv_writer_test.csv";
+  const auto path = test::unique_temp_path("csv_writer_test.csv");
   {
     CsvWriter csv(path.string(), {"step", "error"});
     csv.row({1, 0.5});
@@ -29,7 +31,7 @@ TEST(CsvWriter, WritesHeaderAndRows) {
 }
 
 TEST(TumWriter, WritesPositionAndQuaternion) {
-  const auto path = std::filesystem::temp_directory_path() / "sextant_tum_writer_test.txt";
+  const auto path = test::unique_temp_path("tum_writer_test.txt");
   write_tum(path.string(), {tum_pose_from_position(1.0, Eigen::Vector2d(2.0, 3.0)),
                             tum_pose_from_se2(2.0, 0.0, 0.0, std::numbers::pi)});
   std::istringstream lines(read_all(path));

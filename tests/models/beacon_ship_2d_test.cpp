@@ -57,24 +57,24 @@ TEST(BeaconShip2D, UnbiasedNoiseModelMatchesSampledDisplacementErrors) {
   Eigen::Matrix2d sum_sq = Eigen::Matrix2d::Zero();
   const BeaconShip2D linearized{1.0, 0.26, HeadingNoise::linearized};
   for (int i = 0; i < samples; ++i) {
-    const Eigen::Vector2d u_measured(u_true(0) + motion.sigma_v * unit(rng), u_true(1) + motion.sigma_heading * unit(rng));
-    const Eigen::Vector2d error = motion.predict(x, u_measured, 1.0).x - d_true;
+    const Eigen::Vector2d u_observed(u_true(0) + motion.sigma_v * unit(rng), u_true(1) + motion.sigma_heading * unit(rng));
+    const Eigen::Vector2d error = motion.predict(x, u_observed, 1.0).x - d_true;
     sum += error;
     sum_sq += error * error.transpose();
-    sum_linearized += linearized.predict(x, u_measured, 1.0).x - d_true;
+    sum_linearized += linearized.predict(x, u_observed, 1.0).x - d_true;
   }
   const Eigen::Vector2d bias = sum / samples;
   const Eigen::Matrix2d cov = sum_sq / samples - bias * bias.transpose();
   EXPECT_LT(bias.norm(), 0.02);  // sampling std of the mean ~ 0.004
   // R is the error covariance over the heading the filter does not know: the true heading drawn
-  // around the measured one (sigma_heading), then measured with noise. Pooled over both, the errors
+  // around the observed one (sigma_heading), then observed with noise. Pooled over both, the errors
   // (unbiased for every true heading) have covariance E_h[Cov(error | h)], which R must equal.
   Eigen::Matrix2d pooled = Eigen::Matrix2d::Zero();
   for (int i = 0; i < samples; ++i) {
     const double heading = u_true(1) + motion.sigma_heading * unit(rng);
     const Eigen::Vector2d d = u_true(0) * Eigen::Vector2d(std::cos(heading), std::sin(heading));
-    const Eigen::Vector2d u_measured(u_true(0) + motion.sigma_v * unit(rng), heading + motion.sigma_heading * unit(rng));
-    const Eigen::Vector2d error = motion.predict(x, u_measured, 1.0).x - d;
+    const Eigen::Vector2d u_observed(u_true(0) + motion.sigma_v * unit(rng), heading + motion.sigma_heading * unit(rng));
+    const Eigen::Vector2d error = motion.predict(x, u_observed, 1.0).x - d;
     pooled += error * error.transpose() / samples;
   }
   // Entries ~ 1..7; the sampling std of each is ~ 7 sqrt(2 / 400000) = 0.016: 5 std.

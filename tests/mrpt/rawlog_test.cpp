@@ -10,6 +10,7 @@
 
 #include "mrpt/mrpt_demo_data.hpp"
 #include "support/nees_bound.hpp"
+#include "support/temp_path.hpp"
 #ifdef SEXTANT_HAS_MRPT_SLAM
 #include "support/mrpt_kf_slam.hpp"
 #endif
@@ -122,9 +123,8 @@ TEST(KfSlam6dDemos, EveryBackEndMapsTheSpatialDemo) {
 
 class WrittenRawlog : public ::testing::Test {
  protected:
-  std::filesystem::path dir = std::filesystem::temp_directory_path() /
-                              ("sextant_rawlog_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-                               ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  std::filesystem::path dir =
+      test::unique_temp_path(std::string("rawlog_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
   void SetUp() override { std::filesystem::create_directories(dir); }
   void TearDown() override { std::filesystem::remove_all(dir); }
 

@@ -10,10 +10,10 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <unordered_map>
-#include <unordered_set>
 #include <vector>
 
 #include "sextant/core/error.hpp"
@@ -45,11 +45,18 @@ class SparseInformation {
   const std::unordered_map<std::size_t, CrossBlock>& robot_links() const { return robot_links_; }
   bool is_linked_to_robot(std::size_t slot) const { return robot_links_.contains(slot); }
   void add_to_robot_link(std::size_t slot, const CrossBlock& block) {
+    note_robot_link(slot);
     auto [it, inserted] = robot_links_.try_emplace(slot, block);
     if (!inserted) it->second += block;
   }
-  void set_robot_link(std::size_t slot, const CrossBlock& block) { robot_links_[slot] = block; }
-  void remove_robot_link(std::size_t slot) { robot_links_.erase(slot); }
+  void set_robot_link(std::size_t slot, const CrossBlock& block) {
+    note_robot_link(slot);
+    robot_links_[slot] = block;
+  }
+  void remove_robot_link(std::size_t slot) {
+    note_robot_link(slot);
+    robot_links_.erase(slot);
+  }
 
   LandmarkBlock& diagonal(std::size_t slot) {
     save(slot);
@@ -66,8 +73,8 @@ class SparseInformation {
   const Links& links(std::size_t slot) const { return links_[slot]; }
   /// Omega_{i, j} += block and Omega_{j, i} += block^T, for i != j.
   void add_to_link(std::size_t i, std::size_t j, const LandmarkBlock& block) {
-    save(i);
-    save(j);
+    note_link(i, j);
+    note_link(j, i);
     add_or_insert(links_[i], j, block);
     add_or_insert(links_[j], i, block.transpose());
   }
@@ -86,6 +93,7 @@ class SparseInformation {
   std::size_t append_landmark() {
     diagonal_.push_back(LandmarkBlock::Zero());
     links_.emplace_back();
+    saved_in_.push_back(0);
     landmark_residual_.conservativeResize(landmark_residual_.size() + M);
     landmark_residual_.template tail<M>().setZero();
     return diagonal_.size() - 1;
@@ -114,7 +122,8 @@ class SparseInformation {
   /// keeps its old value. Landmarks may be appended; marginalize_landmark is not allowed.
   void begin_transaction() {
     if (journal_) throw error("SparseInformation: a transaction is already open");
-    journal_.emplace(Journal{robot_, robot_residual_, robot_links_, num_landmarks(), {}, {}});
+    journal_.emplace(Journal{robot_, robot_residual_, num_landmarks(), {}, {}, {}});
+    ++transaction_;
   }
   /// Keeps every change since begin_transaction().
   void commit() { journal_.reset(); }
@@ -132,25 +141,46 @@ class SparseInformation {
     if (!inserted) it->second += block;
   }
   void move_slot(std::size_t from, std::size_t to);
-  /// In a transaction, keeps the old blocks of a slot that existed when it began (once).
+  /// In a transaction, keeps the old diagonal block and residual of a slot that existed when it
+  /// began (once per transaction: saved_in_ holds the transaction that last saved each slot).
   void save(std::size_t slot) {
-    if (!journal_ || slot >= journal_->landmarks || !journal_->saved.insert(slot).second) return;
-    journal_->slots.push_back({slot, diagonal_[slot], landmark_residual_.template segment<M>(M * slot), links_[slot]});
+    if (!journal_ || slot >= journal_->landmarks || saved_in_[slot] == transaction_) return;
+    saved_in_[slot] = transaction_;
+    journal_->slots.push_back({slot, diagonal_[slot], landmark_residual_.template segment<M>(M * slot)});
+  }
+  /// In a transaction, records Omega_{x, slot} (or its absence) before a change.
+  void note_robot_link(std::size_t slot) {
+    if (!journal_) return;
+    const auto it = robot_links_.find(slot);
+    journal_->robot_links.push_back({slot, it == robot_links_.end() ? std::nullopt : std::optional(it->second)});
+  }
+  /// In a transaction, records Omega_{i, j} (or its absence) before a change.
+  void note_link(std::size_t i, std::size_t j) {
+    if (!journal_ || i >= journal_->landmarks) return;
+    const auto it = links_[i].find(j);
+    journal_->links.push_back({i, j, it == links_[i].end() ? std::nullopt : std::optional(it->second)});
   }
 
   struct SavedSlot {
     std::size_t slot;
     LandmarkBlock diagonal;
     LandmarkVector residual;
-    Links links;
+  };
+  struct SavedRobotLink {
+    std::size_t slot;
+    std::optional<CrossBlock> block;  ///< nullopt: there was no link
+  };
+  struct SavedLink {
+    std::size_t i, j;
+    std::optional<LandmarkBlock> block;
   };
   struct Journal {
     RobotBlock robot;
     RobotVector robot_residual;
-    std::unordered_map<std::size_t, CrossBlock> robot_links;
-    std::size_t landmarks;                   ///< landmarks when the transaction began
+    std::size_t landmarks;  ///< landmarks when the transaction began
     std::vector<SavedSlot> slots;
-    std::unordered_set<std::size_t> saved;
+    std::vector<SavedRobotLink> robot_links;  ///< in the order of the changes
+    std::vector<SavedLink> links;
   };
 
   RobotBlock robot_;
@@ -160,6 +190,8 @@ class SparseInformation {
   std::vector<Links> links_;
   Eigen::VectorXd landmark_residual_;
   std::optional<Journal> journal_;
+  std::vector<std::uint64_t> saved_in_;  ///< per slot, see save()
+  std::uint64_t transaction_ = 0;
 };
 
 template <int X, int M>
@@ -169,14 +201,25 @@ void SparseInformation<X, M>::rollback() {
   journal_.reset();
   robot_ = journal.robot;
   robot_residual_ = journal.robot_residual;
-  robot_links_ = std::move(journal.robot_links);
+  for (auto it = journal.robot_links.rbegin(); it != journal.robot_links.rend(); ++it) {  // newest first
+    if (it->block)
+      robot_links_[it->slot] = *it->block;
+    else
+      robot_links_.erase(it->slot);
+  }
+  for (auto it = journal.links.rbegin(); it != journal.links.rend(); ++it) {
+    if (it->block)
+      links_[it->i][it->j] = *it->block;
+    else
+      links_[it->i].erase(it->j);
+  }
   diagonal_.resize(journal.landmarks);
   links_.resize(journal.landmarks);
+  saved_in_.resize(journal.landmarks);
   landmark_residual_.conservativeResize(M * static_cast<Eigen::Index>(journal.landmarks));
-  for (auto& saved : journal.slots) {
+  for (const auto& saved : journal.slots) {
     diagonal_[saved.slot] = saved.diagonal;
     landmark_residual_.template segment<M>(M * saved.slot) = saved.residual;
-    links_[saved.slot] = std::move(saved.links);
   }
 }
 
@@ -211,6 +254,7 @@ void SparseInformation<X, M>::marginalize_landmark(std::size_t slot) {
   if (slot != last) move_slot(last, slot);
   diagonal_.pop_back();
   links_.pop_back();
+  saved_in_.pop_back();
   landmark_residual_.conservativeResize(landmark_residual_.size() - M);
 }
 

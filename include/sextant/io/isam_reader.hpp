@@ -90,6 +90,11 @@ inline PlanarDataset read_isam_2d(const std::string& path, IsamNoise form) {
       if (!value) throw parse_error(where + ": '" + word + "' is not a finite number");
       values.push_back(*value);
     }
+    auto identifier = [&](double value, const char* what) {
+      const auto id = as_identifier(value);
+      if (!id) throw parse_error(where + ": " + what + " must be a non-negative integer below 2^53, got " + std::to_string(value));
+      return *id;
+    };
     auto require_fields = [&](std::size_t count) {
       if (values.size() != count)
         throw parse_error(where + ": " + tag + " needs " + std::to_string(count) + " values, found " +
@@ -97,7 +102,8 @@ inline PlanarDataset read_isam_2d(const std::string& path, IsamNoise form) {
     };
     if (tag == "EDGE2" || tag == "ODOMETRY") {
       require_fields(11);
-      const auto from = static_cast<long long>(values[0]), to = static_cast<long long>(values[1]);
+      const auto from = static_cast<long long>(identifier(values[0], "pose id")),
+                 to = static_cast<long long>(identifier(values[1], "pose id"));
       if (data.pose_ids.empty()) data.pose_ids.push_back(from);
       if (from != data.pose_ids.back())
         throw parse_error(where + ": odometry from pose " + std::to_string(from) + " does not continue the chain (newest pose " +
@@ -110,7 +116,7 @@ inline PlanarDataset read_isam_2d(const std::string& path, IsamNoise form) {
       seen_from_current_pose.clear();
     } else if (tag == "LANDMARK") {
       require_fields(7);
-      const auto pose = static_cast<long long>(values[0]);
+      const auto pose = static_cast<long long>(identifier(values[0], "pose id"));
       if (data.pose_ids.empty()) data.pose_ids.push_back(pose);
       if (pose != data.pose_ids.back())
         throw parse_error(where + ": landmark seen from pose " + std::to_string(pose) + ", but the newest pose is " +
@@ -122,7 +128,7 @@ inline PlanarDataset read_isam_2d(const std::string& path, IsamNoise form) {
       } else if (!cov.isApprox(data.landmark_cov, 1e-12)) {
         throw parse_error(where + ": landmark noise differs from the first LANDMARK record (one measurement model, one Q)");
       }
-      const auto id = static_cast<LandmarkId>(values[1]);
+      const LandmarkId id = identifier(values[1], "landmark id");
       if (!seen_from_current_pose.insert(id).second)
         throw parse_error(where + ": landmark " + std::to_string(id) + " seen twice from pose " + std::to_string(pose));
       Observation<Eigen::Vector2d> observation{id, Eigen::Vector2d(values[2], values[3])};

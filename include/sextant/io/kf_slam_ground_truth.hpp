@@ -53,10 +53,10 @@ std::map<LandmarkId, Eigen::Matrix<double, D, 1>> read_kf_slam_landmarks(const s
   for (const auto& [line, values] : detail::read_numeric_rows(path)) {
     const std::string where = path + ":" + std::to_string(line);
     if (values.size() < 4) throw parse_error(where + ": expected 'x y z ... id', got " + std::to_string(values.size()) + " values");
-    const double id = values.back();
-    if (id < 0 || id != std::floor(id)) throw parse_error(where + ": landmark id must be a non-negative integer");
-    if (!out.emplace(static_cast<LandmarkId>(id), Eigen::Matrix<double, D, 1>(values.data())).second)
-      throw parse_error(where + ": landmark " + std::to_string(static_cast<LandmarkId>(id)) + " appears twice");
+    const auto id = as_identifier(values.back());
+    if (!id) throw parse_error(where + ": landmark id must be a non-negative integer below 2^53");
+    if (!out.emplace(*id, Eigen::Matrix<double, D, 1>(values.data())).second)
+      throw parse_error(where + ": landmark " + std::to_string(*id) + " appears twice");
   }
   if (out.empty()) throw parse_error(path + ": no landmarks");
   return out;
