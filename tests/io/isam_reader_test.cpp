@@ -6,13 +6,28 @@
 
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 namespace sextant::io {
 namespace {
 
+std::vector<std::string>& written_files() {
+  static std::vector<std::string> files;
+  return files;
+}
+
+/// Removes every file write_file wrote when the test program ends.
+struct RemoveWrittenFiles : ::testing::Environment {
+  void TearDown() override {
+    for (const auto& path : written_files()) std::filesystem::remove(path);
+  }
+};
+const auto* const kRemoveWrittenFiles = ::testing::AddGlobalTestEnvironment(new RemoveWrittenFiles);
+
 std::string write_file(const std::string& name, const std::string& text) {
   const auto path = test::unique_temp_path("isam_" + name + ".txt").string();
   std::ofstream(path) << text;
+  written_files().push_back(path);
   return path;
 }
 
