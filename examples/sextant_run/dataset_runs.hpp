@@ -17,6 +17,8 @@ struct RunOptions {
 
 /// The simulated ship, config.ship_runs Monte Carlo runs (run_ship.cpp).
 std::vector<TableRow> run_ship(const RunOptions& options, const std::vector<BackendKind>& kinds, const RunnerConfig& config);
+/// The simulated globe: the 12D camera, every back-end through the landmark pool (run_globe.cpp).
+std::vector<TableRow> run_globe(const RunOptions& options, const std::vector<BackendKind>& kinds, const RunnerConfig& config);
 /// A planar rawlog with its ground truth attached (run_planar_rawlog.cpp).
 std::vector<TableRow> run_rawlog_dataset(const RunOptions& options, const std::string& name,
                                          const mrpt_io::RawlogDataset2D& data, const std::vector<BackendKind>& kinds,

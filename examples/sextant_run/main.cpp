@@ -1,5 +1,5 @@
 // sextant-run: every back-end on the simulated ship and on MRPT rawlogs, scored against ground
-// truth, side by side. With no arguments: all back-ends on the ship Monte Carlo and on the kf-slam
+// truth, side by side; and the thesis's 12D camera around a simulated globe (--dataset globe). With no arguments: all back-ends on the ship Monte Carlo and on the kf-slam
 // demo rawlogs that Debian's mrpt-common installs. See docs/runner.md.
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -97,8 +97,8 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--dataset,-d", options.datasets,
-                 "ship | mrpt-demos | <file.rawlog> (repeatable; default: ship and the MRPT kf-slam demos)");
-  app.add_option("--config,-c", options.config, "ini file (MRPT CConfigFile) with [ship] [rawlog] [ekf] [seif] [graph] "
+                 "ship | globe | mrpt-demos | <file.rawlog> (repeatable; default: ship and the MRPT kf-slam demos)");
+  app.add_option("--config,-c", options.config, "ini file (MRPT CConfigFile) with [ship] [globe] [rawlog] [ekf] [seif] [graph] "
                                                 "[fastslam] [scene] keys; see --print-config");
   app.add_option("--out,-o", options.output.out, "directory for per-step CSV, TUM, .3Dscene files and summary.json");
   app.add_option("--runs", options.runs, "Monte Carlo runs on the ship (overrides [ship] runs)")->check(CLI::Range(1, 100000));
@@ -118,7 +118,9 @@ int main(int argc, char** argv) {
     const auto kinds = parse_backends(options.backends);
     std::vector<TableRow> rows;
     for (const auto& dataset : expand_datasets(options.datasets)) {
-      auto part = dataset == "ship" ? run_ship(options.output, kinds, config) : run_rawlog(options, dataset, kinds, config);
+      auto part = dataset == "ship"    ? run_ship(options.output, kinds, config)
+                  : dataset == "globe" ? run_globe(options.output, kinds, config)
+                                       : run_rawlog(options, dataset, kinds, config);
       rows.insert(rows.end(), part.begin(), part.end());
     }
     std::printf("\naligned: the same error after the best rigid alignment of the trajectory (map) to the truth; "

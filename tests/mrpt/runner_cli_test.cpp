@@ -100,6 +100,44 @@ TEST_F(RunnerCli, PlanarRunWritesTableCsvTumJsonAndALoadableScene) {
   EXPECT_EQ(particles->size(), 100u);  // the default [fastslam] particles
 }
 
+TEST_F(RunnerCli, GlobeRunsEveryBackEndThroughThePoolAndWritesBookkeepingAndScenes) {
+  // A short globe with a small pool, so that eviction happens: one row per back-end configuration.
+  const auto ini = dir / "globe.ini";
+  std::ofstream(ini) << "[globe]\nsteps = 60\npoints = 800\nfeatures_per_frame = 40\nmax_landmarks = 45\n"
+                        "max_new_per_step = 10\nseif_active = 20 0\ngraph_updates = 2\n[fastslam]\nparticles = 10\n";
+  const auto out = dir / "out";
+  const auto r = run_runner("--dataset globe --config " + ini.string() + " --out " + out.string(), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* label : {"EKF-SLAM", "SEIF-SLAM, 20 active", "SEIF-SLAM, all active", "GraphSLAM, windows 50 x 5",
+                            "FastSLAM 1.0", "FastSLAM 2.0", "after each global update"})
+    EXPECT_NE(r.out.find(label), std::string::npos) << label << " not in:\n" << r.out;
+  EXPECT_EQ(r.out.find("nan"), std::string::npos) << "a score not computed must print as -:\n" << r.out;
+  std::ifstream csv(out / "globe" / "ekf_steps.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "step,position_error,rotation_error,in_pool,added,evicted,refused");
+  double evicted = 0.0, most_in_pool = 0.0;
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    std::vector<double> v;
+    std::stringstream fields(line);
+    for (std::string f; std::getline(fields, f, ',');) v.push_back(std::stod(f));
+    ASSERT_EQ(v.size(), 7u);
+    EXPECT_LE(v[3], 45.0) << "pool over capacity at step " << v[0];
+    EXPECT_LE(v[4], 10.0) << "more than max_new added at step " << v[0];
+    evicted += v[5];
+    most_in_pool = std::max(most_in_pool, v[3]);
+    ++rows;
+  }
+  EXPECT_EQ(rows, 60);
+  EXPECT_GT(evicted, 0.0);
+  EXPECT_EQ(most_in_pool, 45.0) << "the pool fills to capacity";
+  mrpt::opengl::COpenGLScene scene;
+  ASSERT_TRUE(scene.loadFromFile((out / "globe" / "seifall.3Dscene").string()));
+  EXPECT_TRUE(scene.getByName(sextant::mrpt_io::scene_names::true_landmarks));
+  EXPECT_TRUE(fs::exists(out / "globe" / "graph_trajectory.tum"));
+}
+
 TEST_F(RunnerCli, SpatialRunDrawsLandmarkEllipsoids) {
   SEXTANT_REQUIRE_MRPT_DEMO("kf-slam_6D_demo_noncentered.rawlog");
   const auto out = dir / "out";

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "sextant/core/concepts.hpp"
@@ -103,6 +104,13 @@ class GraphSlam {
   std::vector<PoseEstimate> trajectory() const;
   LandmarkEstimate<M> landmark(LandmarkId id) const;
   MapEstimate map() const;
+  /// Every landmark's id and mean, O(n): map() without the selected inversion its covariances need
+  /// (which costs much more when landmarks are seen from many poses, as in visual SLAM).
+  std::vector<std::pair<LandmarkId, Landmark>> landmark_means() const {
+    std::vector<std::pair<LandmarkId, Landmark>> out;
+    for (std::size_t slot = 0; slot < pool_.size(); ++slot) out.emplace_back(pool_.id_at(slot), landmark_mean(slot));
+    return out;
+  }
   bool has_landmark(LandmarkId id) const { return pool_.contains(id); }
   std::size_t num_landmarks() const { return pool_.size(); }
   std::size_t num_poses() const { return poses_.size(); }

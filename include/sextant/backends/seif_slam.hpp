@@ -15,6 +15,7 @@
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/landmark_pool.hpp"
 #include "sextant/core/linearized_observation.hpp"
+#include "sextant/core/sparse_cholesky.hpp"
 #include "sextant/core/sparse_information.hpp"
 #include "sextant/core/update_result.hpp"
 #include "sextant/core/versioned_cache.hpp"
@@ -81,6 +82,8 @@ class SeifSlam {
   /// factor of Omega, computed once per change of the filter (O(nnz of the factor)) and shared by
   /// pose(), landmark() and map(). Const methods may be called from several threads at once.
   PoseEstimate pose() const;
+  /// The pose mean alone, O(1): pose() factorizes Omega, which fills in as the map grows.
+  const State& pose_mean() const { return x_; }
   LandmarkEstimate<M> landmark(LandmarkId id) const;
   MapEstimate map() const;
   bool has_landmark(LandmarkId id) const { return pool_.contains(id); }
@@ -97,7 +100,7 @@ class SeifSlam {
  private:
   using Linearized = LinearizedObservation<Z, X, M>;
   using Init = LandmarkInit<M, X, Z>;
-  using Factor = Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>;
+  using Factor = SparseCholesky;  ///< the project's one sparse factorization path (CHOLMOD when linked)
   /// Information that one observation adds: H^T W H and H^T W nu by blocks, W = Q^-1.
   struct MeasurementInformation {
     std::size_t slot;

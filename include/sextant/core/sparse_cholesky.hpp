@@ -45,6 +45,8 @@ class SparseCholesky {
   }
 
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const { return impl_->solver.solve(b); }
+  /// Several right-hand sides at once (e.g. the columns of a marginal covariance).
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& B) const { return impl_->solver.solve(B); }
 
   /// How many symbolic analyses this object has done.
   int analyses() const { return analyses_; }

@@ -281,8 +281,8 @@ void SeifSlam<Motion, Sensor>::recover_mean_exactly() {
 template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::recover_mean_exactly_in_transaction() {
   const Eigen::SparseMatrix<double> omega = info_.to_sparse();
-  const Factor factor(omega);
-  if (factor.info() != Eigen::Success) throw numerical_error("information matrix is not positive definite");
+  Factor factor;
+  factor.factorize(omega);  // throws numerical_error when Omega is not PD
   const Eigen::VectorXd r = info_.residual();
   const Eigen::VectorXd delta = factor.solve(r);
   if (!delta.allFinite()) throw numerical_error("exact mean recovery is not finite");
@@ -381,9 +381,11 @@ void SeifSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
 
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::factorization() const -> std::shared_ptr<const Factor> {
-  auto factor = factor_.get(revision_, [&] { return std::make_shared<const Factor>(info_.to_sparse()); });
-  if (factor->info() != Eigen::Success) throw numerical_error("information matrix is not positive definite");
-  return factor;
+  return factor_.get(revision_, [&] {
+    auto factor = std::make_shared<Factor>();
+    factor->factorize(info_.to_sparse());  // throws numerical_error when Omega is not PD
+    return std::shared_ptr<const Factor>(std::move(factor));
+  });
 }
 
 /// A diagonal block of Omega^-1 from `size` sparse solves.

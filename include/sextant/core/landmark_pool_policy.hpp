@@ -1,0 +1,135 @@
+#pragma once
+/// \file The thesis's bounded landmark pool (seed 000, §4.2.2: P.Mmax and P.max_lm_inc_per_step):
+/// at most max_landmarks in the state, at most max_new_per_step added per step, and when full the
+/// least recently seen landmarks are evicted to make room. The policy only decides; each back-end
+/// removes by its own rule through remove_landmark (EKF: rows and columns deleted; SEIF and
+/// GraphSLAM: marginalization; FastSLAM: from every particle).
+
+#include <algorithm>
+#include <cstddef>
+#include <map>
+#include <set>
+#include <span>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+#include "sextant/core/error.hpp"
+#include "sextant/core/observation.hpp"
+#include "sextant/core/update_result.hpp"
+
+namespace sextant {
+
+struct PoolLimits {
+  std::size_t max_landmarks = 1000;   ///< Mmax
+  std::size_t max_new_per_step = 50;  ///< max_lm_inc_per_step
+};
+
+/// Bookkeeping of one step (the thesis's Figures 22 and 25).
+struct PoolStepRecord {
+  std::size_t in_pool = 0;  ///< landmarks in the state after the step
+  std::size_t added = 0;
+  std::size_t evicted = 0;
+  std::size_t refused = 0;  ///< observations of new landmarks left out (per-step limit or pool full)
+};
+
+/// What one step does: landmarks to remove first, then the observations to hand to update().
+template <class Measurement>
+struct PoolPlan {
+  std::vector<LandmarkId> evict;
+  std::vector<Observation<Measurement>> observations;  ///< every known one, and the admitted new ones
+  std::size_t added = 0, refused = 0;
+};
+
+class LandmarkPoolPolicy {
+ public:
+  explicit LandmarkPoolPolicy(PoolLimits limits) : limits_(limits) {
+    if (limits.max_landmarks == 0) throw invalid_input_error("landmark pool: max_landmarks must be > 0");
+  }
+
+  const PoolLimits& limits() const { return limits_; }
+  std::size_t size() const { return last_seen_.size(); }
+  bool contains(LandmarkId id) const { return last_seen_.contains(id); }
+  const std::vector<PoolStepRecord>& history() const { return history_; }
+
+  /// Plans one step without changing the policy: observations of landmarks in the pool pass; new
+  /// ones are admitted in the order given (a front-end lists its strongest first) up to
+  /// max_new_per_step and up to what eviction can free; the landmarks to evict are the least
+  /// recently seen (ties: the smaller id first), never one observed in this step.
+  template <class Measurement>
+  PoolPlan<Measurement> plan(std::span<const Observation<Measurement>> observations) const {
+    PoolPlan<Measurement> out;
+    std::unordered_set<LandmarkId> seen_now;
+    std::vector<const Observation<Measurement>*> fresh;
+    for (const auto& observation : observations) {
+      if (!seen_now.insert(observation.landmark_id).second)
+        throw duplicate_landmark_error("landmark id " + std::to_string(observation.landmark_id) +
+                                       " is observed twice in one step");
+      if (contains(observation.landmark_id))
+        out.observations.push_back(observation);
+      else
+        fresh.push_back(&observation);
+    }
+    const std::size_t known = out.observations.size();
+    const std::size_t evictable = size() - known;
+    const std::size_t room = limits_.max_landmarks - known;  // at most this many new ones fit beside the known
+    const std::size_t admit = std::min({fresh.size(), limits_.max_new_per_step, room});
+    for (std::size_t i = 0; i < admit; ++i) out.observations.push_back(*fresh[i]);
+    out.added = admit;
+    out.refused = fresh.size() - admit;
+    const std::size_t over = size() + admit > limits_.max_landmarks ? size() + admit - limits_.max_landmarks : 0;
+    for (auto it = by_age_.begin(); out.evict.size() < std::min(over, evictable) && it != by_age_.end(); ++it)
+      if (!seen_now.contains(it->second)) out.evict.push_back(it->second);
+    return out;
+  }
+
+  /// Records that the back-end has removed a landmark.
+  void evicted(LandmarkId id) { forget(id); }
+
+  /// Records a plan once the back-end has updated with its observations (after evicting);
+  /// `step` orders the last sightings.
+  template <class Measurement>
+  void commit(const PoolPlan<Measurement>& plan, std::size_t step) {
+    for (LandmarkId id : plan.evict) forget(id);
+    for (const auto& observation : plan.observations) see(observation.landmark_id, step);
+    history_.push_back({size(), plan.added, plan.evict.size(), plan.refused});
+  }
+
+ private:
+  void forget(LandmarkId id) {
+    const auto it = last_seen_.find(id);
+    if (it == last_seen_.end()) return;
+    by_age_.erase({it->second, id});
+    last_seen_.erase(it);
+  }
+  void see(LandmarkId id, std::size_t step) {
+    forget(id);
+    last_seen_.emplace(id, step);
+    by_age_.emplace(step, id);
+  }
+
+  PoolLimits limits_;
+  std::unordered_map<LandmarkId, std::size_t> last_seen_;
+  std::set<std::pair<std::size_t, LandmarkId>> by_age_;  ///< (last seen, id): the oldest first
+  std::vector<PoolStepRecord> history_;
+};
+
+/// One step of a back-end through the pool: evict, then update with the admitted observations,
+/// then record. Policy and back-end stay in step if the back-end throws: each removal is recorded
+/// as it succeeds, the sightings only after the update succeeds.
+template <class Backend, class Measurement>
+UpdateResult update_through_pool(Backend& backend, LandmarkPoolPolicy& policy,
+                                 std::span<const Observation<Measurement>> observations, std::size_t step) {
+  auto plan = policy.plan(observations);
+  for (LandmarkId id : plan.evict) {
+    backend.remove_landmark(id);
+    policy.evicted(id);
+  }
+  UpdateResult result = backend.update(std::span<const Observation<Measurement>>(plan.observations));
+  policy.commit(plan, step);
+  return result;
+}
+
+}  // namespace sextant
