@@ -226,12 +226,12 @@ TEST_F(RunnerCli, ReadmeTableIsTheProgramsOutput) {
   all << readme.rdbuf();
   std::istringstream readme_lines(all.str());
   EXPECT_EQ(first_line_starting_with(readme_lines, "back-end"), program_header);
-  for (const std::string& label : {"EKF-SLAM", "SEIF-SLAM, 8 active", "GraphSLAM", "FastSLAM 1.0, 100 particles",
+  for (const char* label : {"EKF-SLAM", "SEIF-SLAM, 8 active", "GraphSLAM", "FastSLAM 1.0, 100 particles",
                                    "FastSLAM 2.0, 100 particles"}) {
     EXPECT_NE(r.out.find(label), std::string::npos) << label << " not printed";
     EXPECT_NE(all.str().find(label), std::string::npos) << label << " not in the README";
   }
-  for (const std::string& dataset : {"== ship", "== kf-slam_demo.rawlog", "== kf-slam_6D_demo.rawlog",
+  for (const char* dataset : {"== ship", "== kf-slam_demo.rawlog", "== kf-slam_6D_demo.rawlog",
                                      "== kf-slam_6D_demo_noncentered.rawlog"})
     EXPECT_NE(all.str().find(dataset), std::string::npos) << dataset << " not in the README";
 }
