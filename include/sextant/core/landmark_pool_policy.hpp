@@ -19,6 +19,7 @@
 #include "sextant/core/error.hpp"
 #include "sextant/core/observation.hpp"
 #include "sextant/core/update_result.hpp"
+#include "sextant/core/validation.hpp"
 
 namespace sextant {
 
@@ -60,27 +61,27 @@ class LandmarkPoolPolicy {
   /// recently seen (ties: the smaller id first), never one observed in this step.
   template <class Measurement>
   PoolPlan<Measurement> plan(std::span<const Observation<Measurement>> observations) const {
+    require_valid_observations(observations);  // the back-ends' own check: finite, no id twice
     PoolPlan<Measurement> out;
     std::unordered_set<LandmarkId> seen_now;
     std::vector<const Observation<Measurement>*> fresh;
     for (const auto& observation : observations) {
-      if (!seen_now.insert(observation.landmark_id).second)
-        throw duplicate_landmark_error("landmark id " + std::to_string(observation.landmark_id) +
-                                       " is observed twice in one step");
+      seen_now.insert(observation.landmark_id);
       if (contains(observation.landmark_id))
         out.observations.push_back(observation);
       else
         fresh.push_back(&observation);
     }
     const std::size_t known = out.observations.size();
-    const std::size_t evictable = size() - known;
-    const std::size_t room = limits_.max_landmarks - known;  // at most this many new ones fit beside the known
+    // At most max_landmarks - known new ones fit beside the known, so `over` never exceeds the
+    // size() - known landmarks that may be evicted.
+    const std::size_t room = limits_.max_landmarks - known;
     const std::size_t admit = std::min({fresh.size(), limits_.max_new_per_step, room});
     for (std::size_t i = 0; i < admit; ++i) out.observations.push_back(*fresh[i]);
     out.added = admit;
     out.refused = fresh.size() - admit;
     const std::size_t over = size() + admit > limits_.max_landmarks ? size() + admit - limits_.max_landmarks : 0;
-    for (auto it = by_age_.begin(); out.evict.size() < std::min(over, evictable) && it != by_age_.end(); ++it)
+    for (auto it = by_age_.begin(); out.evict.size() < over && it != by_age_.end(); ++it)
       if (!seen_now.contains(it->second)) out.evict.push_back(it->second);
     return out;
   }
