@@ -17,7 +17,9 @@ configure() { cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DSEXTANT_REQUIR
 case "$mode" in
   main)
     configure -DSEXTANT_BUILD_TESTS=OFF -DSEXTANT_BUILD_BENCHMARKS=OFF
-    cmake --build "$build" -j"$jobs" --target sextant-run
+    targets=(sextant-run)
+    case " $* " in *globe*) targets+=(sextant-globe) ;; esac  # --dataset globe hands over to sextant-globe
+    cmake --build "$build" -j"$jobs" --target "${targets[@]}"
     exec "$build/examples/sextant-run" "$@" ;;
   test|test-slow)
     configure -DSEXTANT_BUILD_TESTS=ON

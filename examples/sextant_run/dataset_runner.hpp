@@ -3,13 +3,13 @@
 // their rows, write their files. Included by the translation units that instantiate it, one per
 // data-set family (run_ship.cpp, run_planar_rawlog.cpp, run_spatial_rawlog.cpp), which a build on
 // several cores compiles side by side.
-#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "dataset_runs.hpp"
 #include "experiments.hpp"
+#include "plot_script.hpp"
 #include "run_outputs.hpp"
 
 namespace sextant::runner {
@@ -28,13 +28,7 @@ void write_dataset_outputs(const RunOptions& options, const std::string& dataset
   for (const auto& [kind, run] : runs) write_run_outputs(dir, kind, run, data, scoring, config);
   std::printf("wrote per-step CSV, map CSV, TUM trajectories and .3Dscene files to %s\n", dir.c_str());
   if (!options.plots) return;
-  const auto script = std::filesystem::canonical("/proc/self/exe").parent_path() / "plot_run.py";
-  // Debian's interpreter (where python3-matplotlib installs) before whatever python3 is first on PATH.
-  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string command = python + " '" + script.string() + "' '" + dir.string() + "' " + unit;
-  if (std::system(command.c_str()) != 0)
-    throw error(dir.string() + ": plotting failed (needs python3 with matplotlib: Debian python3-matplotlib)");
-  std::printf("wrote plots (PNG) to %s\n", dir.c_str());
+  run_plot_script("plot_run.py", dir, unit);
 }
 
 /// Runs the chosen back-ends on one data set, prints its part of the table, writes its outputs.

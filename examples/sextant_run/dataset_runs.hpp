@@ -1,6 +1,5 @@
 #pragma once
-// The runner's data-set runs, each compiled in its own translation unit.
-#include <sextant/mrpt/rawlog.hpp>
+// The runner's data-set runs, each compiled in its own translation unit (the rawlog ones: rawlog_runs.hpp).
 #include <string>
 #include <vector>
 
@@ -19,13 +18,5 @@ struct RunOptions {
 std::vector<TableRow> run_ship(const RunOptions& options, const std::vector<BackendKind>& kinds, const RunnerConfig& config);
 /// The simulated globe: the 12D camera, every back-end through the landmark pool (run_globe.cpp).
 std::vector<TableRow> run_globe(const RunOptions& options, const std::vector<BackendKind>& kinds, const RunnerConfig& config);
-/// A planar rawlog with its ground truth attached (run_planar_rawlog.cpp).
-std::vector<TableRow> run_rawlog_dataset(const RunOptions& options, const std::string& name,
-                                         const mrpt_io::RawlogDataset2D& data, const std::vector<BackendKind>& kinds,
-                                         const RunnerConfig& config);
-/// A spatial (6D) rawlog with its ground truth attached (run_spatial_rawlog.cpp).
-std::vector<TableRow> run_rawlog_dataset(const RunOptions& options, const std::string& name,
-                                         const mrpt_io::RawlogDataset3D& data, const std::vector<BackendKind>& kinds,
-                                         const RunnerConfig& config);
 
 }  // namespace sextant::runner

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "dataset_runs.hpp"
+#include "plot_script.hpp"
 #include "progress_bar.hpp"
 
 namespace sextant::runner {
@@ -22,6 +23,16 @@ namespace {
 
 using Dataset = sim::GlobeCameraDataset;
 using Motion = EulerCamera12D;
+
+/// The simulator's options from the runner's [globe] settings; everything else at its default.
+sim::GlobeCameraOptions globe_options(const GlobeSettings& s) {
+  sim::GlobeCameraOptions o;
+  o.seed = s.seed;
+  o.num_steps = s.steps;
+  o.num_points = s.points;
+  o.max_features_per_frame = s.features_per_frame;
+  return o;
+}
 using Sensor = PointInCamera3D;
 
 /// One back-end configuration's run on the globe, scored.
@@ -39,7 +50,7 @@ struct GlobeRun {
 template <class Backend>
 GlobeRun run_filter(Backend& backend, const Dataset& data, const RunnerConfig& c, std::string key, std::string label) {
   ProgressBar progress("globe: " + key, data.steps.size());
-  auto run = eval::run_through_pool(backend, data.steps, c.globe_pool, c.globe_covariance_period,
+  auto run = eval::run_through_pool(backend, data.steps, c.globe.pool, c.globe.covariance_period,
                                     [&](std::size_t, const Backend&) { progress.advance(); });
   GlobeRun out;
   out.key = std::move(key);
@@ -62,15 +73,15 @@ GlobeRun run_graph(const Dataset& data, const RunnerConfig& c) {
   options.window = 50;
   options.window_iterations = 5;
   GraphSlam<Motion, Sensor> graph(data.motion, data.sensor, data.prior, options);
-  ProgressBar progress("globe: graph", data.steps.size() + static_cast<std::size_t>(c.globe_graph_updates));
-  auto run = eval::run_through_pool(graph, data.steps, c.globe_pool, 0,
+  ProgressBar progress("globe: graph", data.steps.size() + static_cast<std::size_t>(c.globe.graph_updates));
+  auto run = eval::run_through_pool(graph, data.steps, c.globe.pool, 0,
                                     [&](std::size_t, const GraphSlam<Motion, Sensor>&) { progress.advance(); });
   GlobeRun out;
   out.key = "graph";
   out.label = "GraphSLAM, windows 50 x 5";
   out.pool = std::move(run.pool);
   out.total_seconds = run.total_seconds;
-  for (int update = 0; update < c.globe_graph_updates; ++update) {
+  for (int update = 0; update < c.globe.graph_updates; ++update) {
     const auto start = std::chrono::steady_clock::now();
     graph.optimize();
     out.total_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -99,7 +110,7 @@ std::vector<GlobeRun> run_backends(const Dataset& data, const std::vector<Backen
         break;
       }
       case BackendKind::seif:
-        for (std::size_t active : c.globe_seif_active) {
+        for (std::size_t active : c.globe.seif_active) {
           SeifOptions o = c.seif;
           o.max_active = active;
           SeifSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, o);
@@ -196,22 +207,18 @@ void write_globe_outputs(const RunOptions& options, const Dataset& data, const s
   std::printf("wrote per-step CSV (errors and pool bookkeeping), TUM trajectories and .3Dscene files to %s\n",
               dir.c_str());
   if (!options.plots) return;
-  const auto script = std::filesystem::canonical("/proc/self/exe").parent_path() / "plot_globe.py";
-  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  if (std::system((python + " '" + script.string() + "' '" + dir.string() + "'").c_str()) != 0)
-    throw error(dir.string() + ": plotting failed (needs python3 with matplotlib: Debian python3-matplotlib)");
-  std::printf("wrote plots (PNG) to %s\n", dir.c_str());
+  run_plot_script("plot_globe.py", dir);
 }
 
 }  // namespace
 
 std::vector<TableRow> run_globe(const RunOptions& options, const std::vector<BackendKind>& kinds,
                                 const RunnerConfig& config) {
-  const auto data = sim::simulate_globe_camera(config.globe);
+  const auto data = sim::simulate_globe_camera(globe_options(config.globe));
   std::printf("\n== globe: the thesis's 12D camera around a simulated globe, %d steps, %zu points, %d features per "
               "frame, pool Mmax = %zu, max_new = %zu; seed %llu\n",
-              config.globe.num_steps, data.true_landmarks.size(), config.globe.max_features_per_frame,
-              config.globe_pool.max_landmarks, config.globe_pool.max_new_per_step,
+              config.globe.steps, data.true_landmarks.size(), config.globe.features_per_frame,
+              config.globe.pool.max_landmarks, config.globe.pool.max_new_per_step,
               static_cast<unsigned long long>(config.globe.seed));
   const auto runs = run_backends(data, kinds, config);
   print_globe_header();
@@ -228,7 +235,7 @@ std::vector<TableRow> run_globe(const RunOptions& options, const std::vector<Bac
   }
   std::printf("NEES columns: share of sampled steps (every %zu-th; landmarks for the map) inside the 95%% chi-square "
               "bound with 3 dof (7.81); rot: NEES of the rotation vector Log(R^T R_est). Pool at the end: ",
-              config.globe_covariance_period);
+              config.globe.covariance_period);
   if (!runs.empty() && !runs.front().pool.empty()) {
     std::size_t added = 0, evicted = 0;
     for (const auto& p : runs.front().pool) {

@@ -1,5 +1,6 @@
 // sextant-run's planar rawlog part: every chosen back-end on one planar MRPT rawlog.
 #include "dataset_runner.hpp"
+#include "rawlog_runs.hpp"
 
 namespace sextant::runner {
 

@@ -1,5 +1,6 @@
 // sextant-run's spatial rawlog part: every chosen back-end on one spatial MRPT rawlog.
 #include "dataset_runner.hpp"
+#include "rawlog_runs.hpp"
 
 namespace sextant::runner {
 

@@ -16,15 +16,27 @@
 #include <sextant/backends/seif_slam.hpp>
 #include <sextant/core/error.hpp>
 #include <sextant/io/parse_number.hpp>
-#include <sextant/mrpt/rawlog.hpp>
+#include <sextant/mrpt/rawlog_options.hpp>
 #include <sextant/core/landmark_pool_policy.hpp>
-#include <sextant/sim/globe_camera.hpp>
 #include <sextant/sim/ship_2d.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
 namespace sextant::runner {
+
+/// The globe experiment's settings; run_globe.cpp turns them into sim::GlobeCameraOptions (kept apart
+/// so that the main job's translation units do not parse the 12D camera and its simulator).
+struct GlobeSettings {
+  std::uint64_t seed = 1;
+  int steps = 500;                ///< thesis: 500
+  int points = 3000;              ///< feature points on the globe
+  int features_per_frame = 120;   ///< strongest visible points observed per frame
+  PoolLimits pool{.max_landmarks = 1000, .max_new_per_step = 50};  ///< thesis: Mmax = 1000, 50 new per step
+  std::vector<std::size_t> seif_active{150, 250, 0};  ///< one SEIF run per value (0 = all active)
+  std::size_t covariance_period = 10;  ///< pose NEES every this many steps
+  int graph_updates = 10;              ///< GraphSLAM global updates after the windowed initialization
+};
 
 struct RunnerConfig {
   sim::Ship2DOptions ship;
@@ -34,11 +46,7 @@ struct RunnerConfig {
   SeifOptions seif{.max_active = 8};
   GraphOptions graph;
   FastSlamOptions fastslam{.particles = 100, .resample_threshold = 0.1, .map_estimate = FastSlamMap::weighted_average};
-  sim::GlobeCameraOptions globe;
-  PoolLimits globe_pool{.max_landmarks = 1000, .max_new_per_step = 50};
-  std::vector<std::size_t> globe_seif_active{150, 250, 0};
-  std::size_t globe_covariance_period = 10;
-  int globe_graph_updates = 10;
+  GlobeSettings globe;
   double scene_quantile = 3.0;
 };
 
@@ -112,27 +120,27 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"globe", "seed", "1", "simulation seed of the globe (12D camera) experiment",
        [](RunnerConfig& c, const std::string& v) { c.globe.seed = static_cast<std::uint64_t>(parse_integer(v, 0)); }},
       {"globe", "steps", "500", "steps (thesis: 500); the circle closes near step 420",
-       [](RunnerConfig& c, const std::string& v) { c.globe.num_steps = static_cast<int>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.steps = static_cast<int>(parse_integer(v, 1)); }},
       {"globe", "points", "3000", "feature points on the globe",
-       [](RunnerConfig& c, const std::string& v) { c.globe.num_points = static_cast<int>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.points = static_cast<int>(parse_integer(v, 1)); }},
       {"globe", "features_per_frame", "120", "strongest visible points observed per frame",
-       [](RunnerConfig& c, const std::string& v) { c.globe.max_features_per_frame = static_cast<int>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.features_per_frame = static_cast<int>(parse_integer(v, 1)); }},
       {"globe", "max_landmarks", "1000", "landmark pool capacity Mmax (thesis: 1000)",
-       [](RunnerConfig& c, const std::string& v) { c.globe_pool.max_landmarks = static_cast<std::size_t>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_landmarks = static_cast<std::size_t>(parse_integer(v, 1)); }},
       {"globe", "max_new_per_step", "50", "new landmarks per step at most (thesis: 50)",
-       [](RunnerConfig& c, const std::string& v) { c.globe_pool.max_new_per_step = static_cast<std::size_t>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_new_per_step = static_cast<std::size_t>(parse_integer(v, 1)); }},
       {"globe", "seif_active", "150 250 0", "SEIF runs, one per value: active landmarks (0 = all)",
        [](RunnerConfig& c, const std::string& v) {
          std::istringstream in(v);
          std::vector<std::size_t> values;
          for (std::string word; in >> word;) values.push_back(static_cast<std::size_t>(parse_integer(word, 0)));
          if (values.empty()) throw invalid_input_error("'" + v + "' lists no value");
-         c.globe_seif_active = values;
+         c.globe.seif_active = values;
        }},
       {"globe", "covariance_period", "10", "NEES of the pose every this many steps (a SEIF's covariance costs a factorization)",
-       [](RunnerConfig& c, const std::string& v) { c.globe_covariance_period = static_cast<std::size_t>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.covariance_period = static_cast<std::size_t>(parse_integer(v, 1)); }},
       {"globe", "graph_updates", "10", "GraphSLAM global updates after the windowed initialization (thesis Table 10: 10)",
-       [](RunnerConfig& c, const std::string& v) { c.globe_graph_updates = static_cast<int>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = static_cast<int>(parse_integer(v, 1)); }},
       {"rawlog", "std_range", "0", "range noise, m; 0 = as stated in the rawlog",
        [](RunnerConfig& c, const std::string& v) {
          const double x = parse_number(v);

@@ -29,9 +29,9 @@ struct Result {
   std::string out, err;
 };
 
-Result run_runner(const std::string& arguments, const fs::path& dir) {
+Result run_program(const std::string& command_line, const fs::path& dir) {
   const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string command = std::string(SEXTANT_RUN_EXE) + " " + arguments + " >" + out.string() + " 2>" + err.string();
+  const std::string command = command_line + " >" + out.string() + " 2>" + err.string();
   const int status = std::system(command.c_str());
   auto slurp = [](const fs::path& p) {
     std::ifstream in(p);
@@ -40,6 +40,10 @@ Result run_runner(const std::string& arguments, const fs::path& dir) {
     return s.str();
   };
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+}
+
+Result run_runner(const std::string& arguments, const fs::path& dir) {
+  return run_program(std::string(SEXTANT_RUN_EXE) + " " + arguments, dir);
 }
 
 class RunnerCli : public ::testing::Test {
@@ -136,6 +140,16 @@ TEST_F(RunnerCli, GlobeRunsEveryBackEndThroughThePoolAndWritesBookkeepingAndScen
   ASSERT_TRUE(scene.loadFromFile((out / "globe" / "seifall.3Dscene").string()));
   EXPECT_TRUE(scene.getByName(sextant::mrpt_io::scene_names::true_landmarks));
   EXPECT_TRUE(fs::exists(out / "globe" / "graph_trajectory.tum"));
+}
+
+TEST_F(RunnerCli, GlobeRunsAloneInItsOwnProgram) {
+  // sextant-run hands --dataset globe over to sextant-globe; mixing it with other data sets, or giving
+  // sextant-globe another data set, is refused with one line.
+  expect_one_line_error("-d globe -d ship", {"--dataset globe runs alone", "sextant-globe"});
+  const std::string globe = (fs::path(SEXTANT_RUN_EXE).parent_path() / "sextant-globe").string();
+  const auto r = run_program(globe + " -d ship", dir);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("sextant-globe runs only the globe"), std::string::npos) << r.err;
 }
 
 TEST_F(RunnerCli, SpatialRunDrawsLandmarkEllipsoids) {

@@ -139,6 +139,7 @@ class FastSlam {
   void normalize_and_resample(Transaction& t) const;
   PoseEstimate cloud_estimate(const std::vector<Particle>& cloud, const std::vector<PendingMotion>& pending) const;
   static std::vector<double> normalized_weights(const std::vector<Particle>& particles);
+  static double effective_sample_size_of(const std::vector<double>& normalized);
   bool is_current(std::size_t index) const {
     const auto it = index_.find(id_of_index_[index]);
     return it != index_.end() && it->second == index;

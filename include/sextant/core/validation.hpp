@@ -48,6 +48,18 @@ void require_process_noise(const Eigen::MatrixBase<Derived>& R) {
                           std::to_string(smallest) + ")");
 }
 
+/// The motion model's prediction at x, checked before any back-end uses it: mean, Jacobian G and
+/// process noise R finite (numerical_error "motion model returned NaN or Inf" otherwise) and R
+/// symmetric positive semi-definite (require_process_noise).
+template <class Motion, class State, class Control>
+auto checked_motion_prediction(const Motion& motion, const State& x, const Control& u, double dt) {
+  auto prediction = motion.predict(x, u, dt);
+  if (!Motion::Space::is_finite(prediction.x) || !prediction.J_x_x.allFinite() || !prediction.R.allFinite())
+    throw numerical_error("motion model returned NaN or Inf");
+  require_process_noise(prediction.R);
+  return prediction;
+}
+
 /// Throws when an observation is not finite or a landmark id repeats within one update.
 template <class Measurement>
 void require_valid_observations(std::span<const Observation<Measurement>> observations) {

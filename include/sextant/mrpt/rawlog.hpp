@@ -37,6 +37,7 @@
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/observation.hpp"
 #include "sextant/io/kf_slam_ground_truth.hpp"
+#include "sextant/mrpt/rawlog_options.hpp"
 #include "sextant/models/range_bearing_2d.hpp"
 #include "sextant/models/range_bearing_3d.hpp"
 #include "sextant/models/se2_odometry.hpp"
@@ -45,18 +46,6 @@
 /// Adapters between sextant and MRPT. Not `sextant::mrpt`: inside namespace sextant that name
 /// would hide ::mrpt for every user who writes `using namespace sextant`.
 namespace sextant::mrpt_io {
-
-struct RawlogOptions {
-  /// Replace the sensor noise the rawlog states (standard deviations; range in m, angles in rad).
-  std::optional<double> std_range, std_yaw, std_pitch;
-  /// Odometry noise (x, y, heading) per step of an observation-only rawlog (CObservationOdometry
-  /// carries none); the defaults are MRPT kf-slam's stds_Q_no_odo (0.1 m, 0.1 m, 4 deg).
-  Eigen::Vector3d odometry_std = {0.1, 0.1, 4.0 * 3.14159265358979323846 / 180.0};
-  /// Standard deviation of the start pose (the robot starts at the origin of the map frame).
-  double prior_std = 1e-6;
-  /// Read at most this many steps (0: all).
-  std::size_t max_steps = 0;
-};
 
 /// A rawlog as a step stream with the models configured from it; ground truth when attached.
 template <class MotionT, class SensorT>

@@ -26,10 +26,7 @@ template <class Motion, class Sensor>
 void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   require_finite(u, "control");
   require_positive_time_step(dt);
-  const auto prediction = motion_.predict(x_, u, dt);
-  if (!Space::is_finite(prediction.x) || !prediction.J_x_x.allFinite() || !prediction.R.allFinite())
-    throw numerical_error("motion model returned NaN or Inf");
-  require_process_noise(prediction.R);
+  const auto prediction = checked_motion_prediction(motion_, x_, u, dt);
   auto P = cov_.view();
   const auto& G = prediction.J_x_x;
   const Eigen::Index rest = P.rows() - X;

@@ -53,16 +53,6 @@ auto FastSlam<Motion, Sensor, Map>::sample(const State& mean, const Eigen::Matri
   return x;
 }
 
-namespace detail {
-/// The motion model's prediction, checked: finite, with a symmetric positive semi-definite R.
-template <class Motion, class State, class Control>
-auto checked_motion(const Motion& motion, const State& x, const Control& u, double dt) {
-  auto p = motion.predict(x, u, dt);
-  if (!Motion::Space::is_finite(p.x) || !p.R.allFinite()) throw numerical_error("motion model returned NaN or Inf");
-  require_process_noise(p.R);
-  return p;
-}
-}  // namespace detail
 
 template <class Motion, class Sensor, template <class> class Map>
 void FastSlam<Motion, Sensor, Map>::commit(Transaction&& t) {
@@ -87,7 +77,7 @@ void FastSlam<Motion, Sensor, Map>::predict(const Control& u, double dt) {
   if (options_.version == FastSlamVersion::v1)
     apply_pending_motion_v1(t);
   else
-    for (const auto& particle : t.particles) detail::checked_motion(motion_, particle.x, u, dt);
+    for (const auto& particle : t.particles) checked_motion_prediction(motion_, particle.x, u, dt);
   commit(std::move(t));
 }
 
@@ -96,7 +86,7 @@ template <class Motion, class Sensor, template <class> class Map>
 void FastSlam<Motion, Sensor, Map>::apply_pending_motion_v1(Transaction& t) const {
   for (const auto& motion : t.pending)
     for (auto& particle : t.particles) {
-      const auto p = detail::checked_motion(motion_, particle.x, motion.u, motion.dt);
+      const auto p = checked_motion_prediction(motion_, particle.x, motion.u, motion.dt);
       particle.x = sample(p.x, p.R, t.rng);
     }
   t.pending.clear();
@@ -163,7 +153,7 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
   const bool proposal = options_.version == FastSlamVersion::v2 && !t.pending.empty();
   for (auto& particle : t.particles) {
     if (proposal) {
-      const auto p = detail::checked_motion(motion_, particle.x, t.pending.back().u, t.pending.back().dt);
+      const auto p = checked_motion_prediction(motion_, particle.x, t.pending.back().u, t.pending.back().dt);
       sample_v2_proposal(particle, p.x, p.R, known, t.rng);
       for (const auto& observation : known) update_landmark(particle, index_.at(observation.landmark_id), observation.z, false);
     } else {
@@ -208,7 +198,7 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
     State mean = particle.x;
     Eigen::Matrix<double, X, X> cov = Eigen::Matrix<double, X, X>::Zero();
     for (const auto& motion : t.pending) {
-      const auto p = detail::checked_motion(motion_, mean, motion.u, motion.dt);
+      const auto p = checked_motion_prediction(motion_, mean, motion.u, motion.dt);
       mean = proposal ? p.x : sample(p.x, p.R, t.rng);
       if (proposal) cov = p.R;
     }
@@ -278,9 +268,7 @@ void FastSlam<Motion, Sensor, Map>::normalize_and_resample(Transaction& t) const
   t.estimate = cloud_estimate(particles, t.pending);
   const double n = static_cast<double>(particles.size());
   const auto w = normalized_weights(particles);
-  double sum_sq = 0.0;
-  for (double v : w) sum_sq += v * v;
-  if (1.0 / sum_sq >= options_.resample_threshold * n) return;
+  if (effective_sample_size_of(w) >= options_.resample_threshold * n) return;
   std::vector<Particle> resampled;
   resampled.reserve(particles.size());
   const double step = 1.0 / n;
@@ -312,8 +300,14 @@ std::vector<double> FastSlam<Motion, Sensor, Map>::weights() const {
 
 template <class Motion, class Sensor, template <class> class Map>
 double FastSlam<Motion, Sensor, Map>::effective_sample_size() const {
+  return effective_sample_size_of(weights());
+}
+
+/// N_eff = 1 / sum w_i^2 of normalized weights (§3.7.4).
+template <class Motion, class Sensor, template <class> class Map>
+double FastSlam<Motion, Sensor, Map>::effective_sample_size_of(const std::vector<double>& normalized) {
   double sum_sq = 0.0;
-  for (double v : weights()) sum_sq += v * v;
+  for (double v : normalized) sum_sq += v * v;
   return 1.0 / sum_sq;
 }
 
@@ -414,7 +408,11 @@ std::size_t FastSlam<Motion, Sensor, Map>::num_landmarks() const {
 template <class Motion, class Sensor, template <class> class Map>
 std::vector<LandmarkId> FastSlam<Motion, Sensor, Map>::landmark_ids() const {
   std::vector<LandmarkId> out;
-  for (const auto& landmark : map()) out.push_back(landmark.id);
+  for (std::size_t index = 0; index < id_of_index_.size(); ++index)
+    if (is_current(index)) out.push_back(id_of_index_[index]);
+  const auto& own = particles_[best_particle()].unassociated;
+  for (std::size_t j = 0; j < own.size(); ++j)
+    if (own[j].alive) out.push_back(own[j].id);
   return out;
 }
 

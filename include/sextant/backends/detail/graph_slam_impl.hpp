@@ -79,10 +79,7 @@ template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   require_finite(u, "control");
   require_positive_time_step(dt);
-  const auto prediction = motion_.predict(poses_.back(), u, dt);
-  if (!Space::is_finite(prediction.x) || !prediction.J_x_x.allFinite() || !prediction.R.allFinite())
-    throw numerical_error("motion model returned NaN or Inf");
-  require_process_noise(prediction.R);
+  const auto prediction = checked_motion_prediction(motion_, poses_.back(), u, dt);
   if constexpr (!HasBetweenFactor<Motion>)  // the motion factor is weighted by R^-1
     cholesky_or_throw(prediction.R, "process noise R of step " + std::to_string(motions_.size()) +
                                         " (GraphSLAM weights the motion factor by R^-1)");

@@ -33,10 +33,7 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   using MatrixX = Eigen::Matrix<double, X, X>;
   require_finite(u, "control");
   require_positive_time_step(dt);
-  const auto prediction = motion_.predict(x_, u, dt);
-  if (!Space::is_finite(prediction.x) || !prediction.J_x_x.allFinite() || !prediction.R.allFinite())
-    throw numerical_error("motion model returned NaN or Inf");
-  require_process_noise(prediction.R);
+  const auto prediction = checked_motion_prediction(motion_, x_, u, dt);
   const auto singular_values = Eigen::JacobiSVD<MatrixX>(prediction.J_x_x).singularValues();
   if (!(singular_values(X - 1) > 1e-12 * singular_values(0)))
     throw numerical_error("motion Jacobian G is singular; the SEIF motion update needs G^-1");

@@ -1,0 +1,100 @@
+#pragma once
+// The command line that sextant-run and sextant-globe share: options, back-end names, the legend and
+// summary.json after the table, one-line errors.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "dataset_runs.hpp"
+#include "runner_config.hpp"
+#include "table.hpp"
+
+namespace sextant::runner {
+
+struct CliOptions {
+  std::vector<std::string> backends{"all"};
+  std::vector<std::string> datasets;
+  std::string config;
+  int runs = 0;
+  bool print_config = false;
+  RunOptions output;
+};
+
+/// Declares the options both programs take.
+inline void add_runner_options(CLI::App& app, CliOptions& options) {
+  app.add_option("--backend,-b", options.backends, "ekf|seif|graph|fastslam1|fastslam2|all (repeatable)")
+      ->delimiter(',')
+      ->capture_default_str();
+  app.add_option("--dataset,-d", options.datasets,
+                 "ship | globe | mrpt-demos | <file.rawlog> (repeatable; default: ship and the MRPT kf-slam demos)");
+  app.add_option("--config,-c", options.config, "ini file (MRPT CConfigFile) with [ship] [globe] [rawlog] [ekf] [seif] [graph] "
+                                                "[fastslam] [scene] keys; see --print-config");
+  app.add_option("--out,-o", options.output.out, "directory for per-step CSV, TUM, .3Dscene files and summary.json");
+  app.add_option("--runs", options.runs, "Monte Carlo runs on the ship (overrides [ship] runs)")->check(CLI::Range(1, 100000));
+  app.add_flag("--plots", options.output.plots, "also write PNG plots of trajectory, map, error and NEES (needs --out or "
+                                                "writes to ./sextant-run-output)");
+  app.add_flag("--print-config", options.print_config, "print every config key with its default and meaning, then exit");
+}
+
+inline std::vector<BackendKind> parse_backends(const std::vector<std::string>& names) {
+  std::vector<BackendKind> kinds;
+  for (const auto& name : names) {
+    if (name == "all") return all_backends();
+    const auto it = std::find_if(all_backends().begin(), all_backends().end(),
+                                 [&](BackendKind k) { return backend_key(k) == name; });
+    if (it == all_backends().end())
+      throw invalid_input_error("--backend: unknown back-end '" + name + "' (ekf|seif|graph|fastslam1|fastslam2|all)");
+    if (std::find(kinds.begin(), kinds.end(), *it) == kinds.end()) kinds.push_back(*it);
+  }
+  return kinds;
+}
+
+/// The config file with the command line's overrides applied.
+inline RunnerConfig load_runner_config(CliOptions& options) {
+  RunnerConfig config = load_config(options.config);
+  if (options.runs > 0) config.ship_runs = options.runs;
+  if (options.output.plots && options.output.out.empty()) options.output.out = "sextant-run-output";
+  return config;
+}
+
+/// What follows the table: the legend of its columns and, with --out, summary.json.
+inline void finish_run(const CliOptions& options, const std::vector<TableRow>& rows) {
+  std::printf("\naligned: the same error after the best rigid alignment of the trajectory (map) to the truth; "
+              "NEES in: share of steps (pose) or landmarks (map) whose NEES is inside the 95%% chi-square bound; "
+              "pose ANEES: mean NEES over steps and runs (pose dof: ship 2, planar 3, 6D 6).\n");
+  if (options.output.out.empty()) return;
+  std::filesystem::create_directories(options.output.out);
+  const auto json = (std::filesystem::path(options.output.out) / "summary.json").string();
+  write_summary_json(json, rows);
+  std::printf("wrote %s\n", json.c_str());
+}
+
+inline std::string one_line(const std::string& text) {
+  std::string line = text.substr(0, text.find('\n'));
+  return line.empty() ? "unknown error" : line;
+}
+
+/// Both programs' main: parse the options, answer --print-config, then `run(options)`; an error is
+/// one line on stderr, naming the program, and exit code 1.
+template <class Run>
+int runner_main(int argc, char** argv, const char* program, const std::string& description, Run run) {
+  CLI::App app{description};
+  CliOptions options;
+  add_runner_options(app, options);
+  CLI11_PARSE(app, argc, argv);
+  if (options.print_config) {
+    std::fputs(documented_defaults().c_str(), stdout);
+    return 0;
+  }
+  try {
+    return run(options);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", program, one_line(e.what()).c_str());
+    return 1;
+  }
+}
+
+}  // namespace sextant::runner
