@@ -4,6 +4,12 @@
 #   ./run.sh            the main job: sextant-run, every back-end on the ship simulation and MRPT's
 #                       kf-slam demo rawlogs, comparison table
 #   ./run.sh test       the test suite (ctest; tests labelled 'slow' are left out: ./run.sh test-slow runs them)
+#   ./run.sh test-sanitize  the same suite built with AddressSanitizer + UndefinedBehaviorSanitizer (-O1,
+#                       any report stops the test) in build-sanitize/, without the example programs and
+#                       the slow, statistical and install tests
+#   ./run.sh test-tsan  the thread-safety tests (concurrent reads, Monte Carlo threads) under ThreadSanitizer
+#   ./run.sh fuzz [s]   every reader's libFuzzer target (clang, ASan + UBSan) for s seconds each
+#                       (default 60) in build-fuzz/, seeds from ../shared/data and MRPT's demo files
 #   ./run.sh bench      the Google Benchmark programs
 # Extra arguments after the mode go to the program it runs.
 set -euo pipefail
@@ -27,9 +33,33 @@ case "$mode" in
     label=(-LE slow)
     [ "$mode" = test-slow ] && label=(-L slow)
     cd "$build" && exec ctest --output-on-failure -j"$jobs" "${label[@]}" "$@" ;;
+  test-sanitize)
+    build=${SEXTANT_SANITIZE_BUILD_DIR:-build-sanitize}
+    cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DSEXTANT_SANITIZE=address,undefined \
+          -DSEXTANT_REQUIRE_ALL_DEPENDENCIES=ON -DSEXTANT_BUILD_TESTS=ON -DSEXTANT_BUILD_EXAMPLES=OFF \
+          -DSEXTANT_BUILD_BENCHMARKS=OFF >/dev/null
+    cmake --build "$build" -j"$jobs" --target sextant_tests
+    export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:strict_string_checks=1}
+    export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+    cd "$build" && exec ctest --output-on-failure -j"$jobs" -LE "slow|statistical|install" "$@" ;;
+  test-tsan)
+    build=${SEXTANT_TSAN_BUILD_DIR:-build-tsan}
+    cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DSEXTANT_SANITIZE=thread \
+          -DSEXTANT_BUILD_TESTS=ON -DSEXTANT_BUILD_EXAMPLES=OFF -DSEXTANT_BUILD_BENCHMARKS=OFF >/dev/null
+    cmake --build "$build" -j"$jobs" --target concurrent_reads_test monte_carlo_test
+    export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1}
+    cd "$build" && exec ctest --output-on-failure -j"$jobs" -R "^(ConcurrentReads|MonteCarlo)" "$@" ;;
+  fuzz)
+    bash cmake/install_deps.sh clang  # libFuzzer comes with clang's runtime libraries
+    build=${SEXTANT_FUZZ_BUILD_DIR:-build-fuzz}
+    cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DCMAKE_CXX_COMPILER=clang++ \
+          -DSEXTANT_BUILD_FUZZERS=ON -DSEXTANT_BUILD_TESTS=OFF -DSEXTANT_BUILD_EXAMPLES=OFF -DSEXTANT_BUILD_BENCHMARKS=OFF \
+          -DSEXTANT_REQUIRE_ALL_DEPENDENCIES=ON >/dev/null
+    cmake --build "$build" -j"$jobs" --target sextant_fuzzers
+    exec bash cmake/fuzz.sh "$build" "${1:-60}" ;;
   bench)
     configure -DSEXTANT_BUILD_BENCHMARKS=ON
     cmake --build "$build" -j"$jobs" --target sextant_benchmarks
     for b in "$build"/benchmarks/*_benchmark; do "$b" "$@"; done ;;
-  *) echo "usage: ./run.sh [main|test|test-slow|bench] [args...]" >&2; exit 2 ;;
+  *) echo "usage: ./run.sh [main|test|test-slow|test-sanitize|test-tsan|fuzz|bench] [args...]" >&2; exit 2 ;;
 esac

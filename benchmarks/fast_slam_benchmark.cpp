@@ -10,13 +10,13 @@
 #include <numbers>
 #include <sextant/sextant.hpp>
 
-#include "circle_world.hpp"
+#include "sextant/testing/circle_world.hpp"
 
 namespace {
 
 using namespace sextant;
-using bench::CircleWorld;
-using bench::heap_in_use;
+using testing::CircleWorld;
+using testing::heap_in_use;
 constexpr std::size_t kParticles = 100;
 
 template <template <class> class Map>

@@ -9,13 +9,13 @@
 #include <numbers>
 #include <sextant/sextant.hpp>
 
-#include "circle_world.hpp"
+#include "sextant/testing/circle_world.hpp"
 
 namespace {
 
 using namespace sextant;
-using bench::CircleWorld;
-using bench::heap_in_use;
+using testing::CircleWorld;
+using testing::heap_in_use;
 using Seif = SeifSlam<BeaconShip2D, BeaconOffset2D>;
 using Ekf = EkfSlam<BeaconShip2D, BeaconOffset2D>;
 constexpr std::size_t kMaxActive = 8;

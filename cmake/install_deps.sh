@@ -3,7 +3,7 @@
 set -euo pipefail
 # libmrpt-dev: rawlogs, 3D scenes, CConfigFile; mrpt-common: the kf-slam demo rawlogs; python3-matplotlib: --plots
 packages=(cmake make g++ libeigen3-dev libboost-dev libgtest-dev libbenchmark-dev libcli11-dev libsuitesparse-dev libceres-dev
-          libmrpt-dev mrpt-common python3-matplotlib)
+          libmrpt-dev mrpt-common python3-matplotlib "$@")  # "$@": a mode's extras (./run.sh fuzz: clang)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -6,16 +6,20 @@
 // error naming the file, the section and the key.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <filesystem>
 #include <functional>
 #include <mrpt/config/CConfigFile.h>
 #include <numbers>
+#include <optional>
 #include <sextant/backends/ekf_slam.hpp>
 #include <sextant/backends/fast_slam.hpp>
 #include <sextant/backends/graph_slam.hpp>
 #include <sextant/backends/seif_slam.hpp>
 #include <sextant/core/error.hpp>
 #include <sextant/io/parse_number.hpp>
+#include <sextant/mrpt/exception_text.hpp>
 #include <sextant/mrpt/rawlog_options.hpp>
 #include <sextant/core/landmark_pool_policy.hpp>
 #include <sextant/sim/ship_2d.hpp>
@@ -64,11 +68,18 @@ inline double parse_number(const std::string& text) {
   return *value;
 }
 
-inline long long parse_integer(const std::string& text, long long min) {
+/// An integer of type T in [min, max], where max is T's largest value or 2^53 (the largest up to
+/// which every integer is a double), whichever is smaller: no value is silently truncated.
+template <class T>
+T parse_integer(const std::string& text, long long min) {
   const double value = parse_number(text);
-  if (value != std::floor(value) || value < static_cast<double>(min))
-    throw invalid_input_error("'" + text + "' is not an integer >= " + std::to_string(min));
-  return static_cast<long long>(value);
+  const double max = std::min(static_cast<double>(std::numeric_limits<T>::max()), 9007199254740992.0);
+  if (value != std::floor(value) || value < static_cast<double>(min) || value > max) {
+    char range[64];
+    std::snprintf(range, sizeof range, "[%lld, %.0f]", min, max);
+    throw invalid_input_error("'" + text + "' is not an integer in " + range);
+  }
+  return static_cast<T>(value);
 }
 
 inline bool parse_bool(const std::string& text) {
@@ -108,39 +119,39 @@ inline const std::vector<ConfigKey>& config_keys() {
   constexpr double deg = std::numbers::pi / 180.0;
   static const std::vector<ConfigKey> keys = {
       {"ship", "seed", "1", "first simulation seed of the 2D beacon-ship Monte Carlo runs",
-       [](RunnerConfig& c, const std::string& v) { c.ship.seed = static_cast<std::uint64_t>(parse_integer(v, 0)); }},
+       [](RunnerConfig& c, const std::string& v) { c.ship.seed = parse_integer<std::uint64_t>(v, 0); }},
       {"ship", "runs", "10", "Monte Carlo runs (seeds seed .. seed+runs-1); the table averages them",
-       [](RunnerConfig& c, const std::string& v) { c.ship_runs = static_cast<int>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.ship_runs = parse_integer<int>(v, 1); }},
       {"ship", "steps", "1390", "steps per run (thesis: 1390)",
-       [](RunnerConfig& c, const std::string& v) { c.ship.num_steps = static_cast<int>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.ship.num_steps = parse_integer<int>(v, 1); }},
       {"ship", "sigma_heading_deg", "15", "compass noise, degrees (thesis: 15)",
        [](RunnerConfig& c, const std::string& v) { c.ship.sigma_heading = positive(parse_number(v), v) * deg; }},
       {"ship", "sigma_beacon", "2", "beacon offset noise per axis, km",
        [](RunnerConfig& c, const std::string& v) { c.ship.sigma_beacon = positive(parse_number(v), v); }},
       {"globe", "seed", "1", "simulation seed of the globe (12D camera) experiment",
-       [](RunnerConfig& c, const std::string& v) { c.globe.seed = static_cast<std::uint64_t>(parse_integer(v, 0)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.seed = parse_integer<std::uint64_t>(v, 0); }},
       {"globe", "steps", "500", "steps (thesis: 500); the circle closes near step 420",
-       [](RunnerConfig& c, const std::string& v) { c.globe.steps = static_cast<int>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.steps = parse_integer<int>(v, 1); }},
       {"globe", "points", "3000", "feature points on the globe",
-       [](RunnerConfig& c, const std::string& v) { c.globe.points = static_cast<int>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.points = parse_integer<int>(v, 1); }},
       {"globe", "features_per_frame", "120", "strongest visible points observed per frame",
-       [](RunnerConfig& c, const std::string& v) { c.globe.features_per_frame = static_cast<int>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.features_per_frame = parse_integer<int>(v, 1); }},
       {"globe", "max_landmarks", "1000", "landmark pool capacity Mmax (thesis: 1000)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_landmarks = static_cast<std::size_t>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_landmarks = parse_integer<std::size_t>(v, 1); }},
       {"globe", "max_new_per_step", "50", "new landmarks per step at most (thesis: 50)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_new_per_step = static_cast<std::size_t>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_new_per_step = parse_integer<std::size_t>(v, 1); }},
       {"globe", "seif_active", "150 250 0", "SEIF runs, one per value: active landmarks (0 = all)",
        [](RunnerConfig& c, const std::string& v) {
          std::istringstream in(v);
          std::vector<std::size_t> values;
-         for (std::string word; in >> word;) values.push_back(static_cast<std::size_t>(parse_integer(word, 0)));
+         for (std::string word; in >> word;) values.push_back(parse_integer<std::size_t>(word, 0));
          if (values.empty()) throw invalid_input_error("'" + v + "' lists no value");
          c.globe.seif_active = values;
        }},
       {"globe", "covariance_period", "10", "NEES of the pose every this many steps (a SEIF's covariance costs a factorization)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.covariance_period = static_cast<std::size_t>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.covariance_period = parse_integer<std::size_t>(v, 1); }},
       {"globe", "graph_updates", "10", "GraphSLAM global updates after the windowed initialization (thesis Table 10: 10)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = static_cast<int>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = parse_integer<int>(v, 1); }},
       {"rawlog", "std_range", "0", "range noise, m; 0 = as stated in the rawlog",
        [](RunnerConfig& c, const std::string& v) {
          const double x = parse_number(v);
@@ -165,7 +176,7 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"rawlog", "prior_std", "1e-06", "standard deviation of the start pose (the robot starts at the map origin)",
        [](RunnerConfig& c, const std::string& v) { c.rawlog.prior_std = positive(parse_number(v), v); }},
       {"rawlog", "max_steps", "0", "read at most this many steps; 0 = all",
-       [](RunnerConfig& c, const std::string& v) { c.rawlog.max_steps = static_cast<std::size_t>(parse_integer(v, 0)); }},
+       [](RunnerConfig& c, const std::string& v) { c.rawlog.max_steps = parse_integer<std::size_t>(v, 0); }},
       {"ekf", "batch_update", "true", "one joint correction per step (true) or one per observation (false)",
        [](RunnerConfig& c, const std::string& v) { c.ekf.batch_update = parse_bool(v); }},
       {"ekf", "covariance_update", "symmetric", "symmetric (lower-triangle rank update) | joseph",
@@ -180,18 +191,18 @@ inline const std::vector<ConfigKey>& config_keys() {
          c.ekf.gate_probability = p;
        }},
       {"seif", "max_active", "8", "landmarks kept linked to the robot by sparsification; 0 = no sparsification",
-       [](RunnerConfig& c, const std::string& v) { c.seif.max_active = static_cast<std::size_t>(parse_integer(v, 0)); }},
+       [](RunnerConfig& c, const std::string& v) { c.seif.max_active = parse_integer<std::size_t>(v, 0); }},
       {"seif", "mean_recovery", "active_block", "active_block (joint solve) | coordinate_descent (thesis)",
        [](RunnerConfig& c, const std::string& v) {
          c.seif.mean_recovery = parse_choice<MeanRecovery>(
              v, {{"active_block", MeanRecovery::active_block}, {"coordinate_descent", MeanRecovery::coordinate_descent}});
        }},
       {"seif", "mean_recovery_sweeps", "1", "recovery sweeps per update",
-       [](RunnerConfig& c, const std::string& v) { c.seif.mean_recovery_sweeps = static_cast<int>(parse_integer(v, 0)); }},
+       [](RunnerConfig& c, const std::string& v) { c.seif.mean_recovery_sweeps = parse_integer<int>(v, 0); }},
       {"seif", "exact_recovery_period", "0", "every K updates an exact solve of the whole mean; 0 = never",
-       [](RunnerConfig& c, const std::string& v) { c.seif.exact_recovery_period = static_cast<int>(parse_integer(v, 0)); }},
+       [](RunnerConfig& c, const std::string& v) { c.seif.exact_recovery_period = parse_integer<int>(v, 0); }},
       {"graph", "max_iterations", "10", "Gauss-Newton iterations at most",
-       [](RunnerConfig& c, const std::string& v) { c.graph.max_iterations = static_cast<int>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.graph.max_iterations = parse_integer<int>(v, 1); }},
       {"graph", "solver", "automatic", "automatic | landmark_schur (thesis) | full (sparse Cholesky of everything)",
        [](RunnerConfig& c, const std::string& v) {
          c.graph.solver = parse_choice<GraphSolver>(v, {{"automatic", GraphSolver::automatic},
@@ -201,9 +212,9 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"graph", "levenberg_marquardt", "false", "damp the Gauss-Newton steps",
        [](RunnerConfig& c, const std::string& v) { c.graph.levenberg_marquardt = parse_bool(v); }},
       {"graph", "window", "0", "windowed initialization: optimize growing parts of this many steps first; 0 = off",
-       [](RunnerConfig& c, const std::string& v) { c.graph.window = static_cast<std::size_t>(parse_integer(v, 0)); }},
+       [](RunnerConfig& c, const std::string& v) { c.graph.window = parse_integer<std::size_t>(v, 0); }},
       {"fastslam", "particles", "100", "particles",
-       [](RunnerConfig& c, const std::string& v) { c.fastslam.particles = static_cast<std::size_t>(parse_integer(v, 1)); }},
+       [](RunnerConfig& c, const std::string& v) { c.fastslam.particles = parse_integer<std::size_t>(v, 1); }},
       {"fastslam", "resample_threshold", "0.1", "resample when N_eff < threshold * particles (1 = always, 0 = never)",
        [](RunnerConfig& c, const std::string& v) {
          const double t = parse_number(v);
@@ -216,7 +227,7 @@ inline const std::vector<ConfigKey>& config_keys() {
              parse_choice<FastSlamMap>(v, {{"best_particle", FastSlamMap::best_particle}, {"weighted_average", FastSlamMap::weighted_average}});
        }},
       {"fastslam", "seed", "1", "random seed",
-       [](RunnerConfig& c, const std::string& v) { c.fastslam.seed = static_cast<std::uint64_t>(parse_integer(v, 0)); }},
+       [](RunnerConfig& c, const std::string& v) { c.fastslam.seed = parse_integer<std::uint64_t>(v, 0); }},
       {"scene", "quantile", "3", "size of the covariance ellipses in the .3Dscene, standard deviations",
        [](RunnerConfig& c, const std::string& v) { c.scene_quantile = positive(parse_number(v), v); }},
   };
@@ -243,9 +254,17 @@ inline RunnerConfig load_config(const std::string& path) {
   for (const auto& k : config_keys()) k.apply(config, k.default_value);
   if (path.empty()) return config;
   if (!std::filesystem::is_regular_file(path)) throw invalid_input_error(path + ": cannot open config file");
-  ::mrpt::config::CConfigFile file(path);
+  // MRPT's parser throws its own exceptions on what it cannot expand ("$env{" without its "}", a
+  // broken "$eval{...}"): a file we cannot read is an invalid_input_error like any other.
+  std::optional<::mrpt::config::CConfigFile> parsed;
   std::vector<std::string> sections;
-  file.getAllSections(sections);
+  try {
+    parsed.emplace(path);
+    parsed->getAllSections(sections);
+  } catch (const std::exception& e) {
+    throw invalid_input_error(path + ": not a readable ini file (" + mrpt_io::exception_message(e.what()) + ")");
+  }
+  auto& file = *parsed;
   for (const auto& section : sections) {
     std::vector<std::string> names;
     file.getAllKeys(section, names);

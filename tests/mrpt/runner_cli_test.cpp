@@ -204,6 +204,16 @@ TEST_F(RunnerCli, BadConfigEndsWithOneLineNamingFileKeyAndProblem) {
   std::ofstream(ini) << "[nonsense]\nkey = 1\n";
   expect_one_line_error("-d ship -c " + ini, {ini, "[nonsense] key", "unknown key"});
 
+  // Found by the fuzzer (tests/fuzz/runner_config_fuzz): MRPT's parser threw its own exception on an
+  // unclosed "$env{X", which escaped as an uncaught exception.
+  std::ofstream(ini) << "[ekf]\nbatch_update = $env{X\n";
+  expect_one_line_error("-d ship -c " + ini, {ini, "not a readable ini file (Line 2: Expected closing"});
+
+  // Found by the fuzzer: 5.5e81 was converted to long long (undefined behaviour), and values above
+  // an int's range were truncated silently.
+  std::ofstream(ini) << "[ship]\nruns = 5.5e81\n";
+  expect_one_line_error("-d ship -c " + ini, {ini, "[ship] runs", "is not an integer in [1, 2147483647]"});
+
   const auto missing = (dir / "missing.ini").string();
   expect_one_line_error("-d ship -c " + missing, {missing, "cannot open config file"});
 

@@ -40,6 +40,10 @@ struct EkfOptions {
 /// Prediction touches only the robot rows and columns of P (eqs. 10-13); an update uses only the
 /// robot and landmark blocks of H, so P H^T costs O(n) per observation (eqs. 14-17); new landmarks
 /// are added with the cross-covariance of the model's inverse.
+/// Threads: const methods (pose(), map(), landmark(), covariance(), ...) may be called from several threads
+/// at once on one estimator; a non-const one (predict, update, remove_landmark, reserve) must not overlap any other call on it.
+/// Independent estimators share nothing (tests/backends/concurrent_reads_test.cpp, under
+/// ThreadSanitizer with ./run.sh test-tsan).
 template <class Motion, class Sensor>
 class EkfSlam {
   static_assert(ModelsFit<Motion, Sensor>::value, "EkfSlam: the models do not fit (see the message above)");

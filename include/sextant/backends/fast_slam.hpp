@@ -56,6 +56,10 @@ struct LandmarkGaussian {
 /// FastSLAM: N particles, each a pose and a map of independent landmark EKFs. `Map` holds a
 /// particle's landmarks: PersistentArray (default) shares them between particles after resampling;
 /// CopiedArray copies them (O(J) per copy), for comparison.
+/// Threads: const methods (pose(), map(), landmark(), effective_sample_size(), ...) may be called from several threads
+/// at once on one estimator; a non-const one (predict, update, remove_landmark) must not overlap any other call on it.
+/// Independent estimators share nothing (tests/backends/concurrent_reads_test.cpp, under
+/// ThreadSanitizer with ./run.sh test-tsan).
 template <class Motion, class Sensor, template <class> class Map = PersistentArray>
 class FastSlam {
   static_assert(ModelsFit<Motion, Sensor>::value, "FastSlam: the models do not fit (see the message above)");

@@ -60,6 +60,10 @@ struct OptimizationSummary {
 /// relinearizing until the step or the cost change is small. New poses start at dead reckoning,
 /// new landmarks at the inverse measurement model. Marginal covariances of every pose and landmark
 /// come from a selected inversion of the sparse information matrix.
+/// Threads: const methods (pose(), map(), landmark(), ...) may be called from several threads
+/// at once on one estimator; a non-const one (predict, update, remove_landmark, optimize, warm_start) must not overlap any other call on it.
+/// Independent estimators share nothing (tests/backends/concurrent_reads_test.cpp, under
+/// ThreadSanitizer with ./run.sh test-tsan).
 template <class Motion, class Sensor>
 class GraphSlam {
   static_assert(ModelsFit<Motion, Sensor>::value, "GraphSlam: the models do not fit (see the message above)");
@@ -143,6 +147,9 @@ class GraphSlam {
   struct Linearization;  // defined in the implementation
 
   BetweenFactor<X> motion_factor(std::size_t k) const;
+  template <int D>
+  static void require_factorizable_extension(const Eigen::Matrix<double, X, X>& P, const Eigen::Matrix<double, D, X>& J,
+                                             const Eigen::Matrix<double, D, D>& C, const std::string& what);
   Linearization linearize(std::size_t pose_count) const;
   Eigen::VectorXd solve_by_landmark_schur(const Linearization& system, OptimizationSummary& summary) const;
   Eigen::VectorXd solve_full(const Linearization& system, OptimizationSummary& summary) const;

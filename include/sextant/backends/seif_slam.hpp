@@ -44,6 +44,10 @@ struct SeifOptions {
 /// mean of the robot and the active landmarks is recovered by coordinate descent (eqs. 31-36);
 /// sparsification keeps at most max_active landmarks linked to the robot (eqs. 37-44, Appendix A).
 /// Covariances are computed on demand by sparse Cholesky solves, never by inverting Omega.
+/// Threads: const methods (pose(), map(), landmark(), information_matrix(), ...) may be called from several threads
+/// at once on one estimator; a non-const one (predict, update, remove_landmark, recover_mean_exactly) must not overlap any other call on it.
+/// Independent estimators share nothing (tests/backends/concurrent_reads_test.cpp, under
+/// ThreadSanitizer with ./run.sh test-tsan).
 template <class Motion, class Sensor>
 class SeifSlam {
   static_assert(ModelsFit<Motion, Sensor>::value, "SeifSlam: the models do not fit (see the message above)");
@@ -80,7 +84,7 @@ class SeifSlam {
 
   /// Pose mean (as recovered) with its marginal covariance by sparse solves with the Cholesky
   /// factor of Omega, computed once per change of the filter (O(nnz of the factor)) and shared by
-  /// pose(), landmark() and map(). Const methods may be called from several threads at once.
+  /// pose(), landmark() and map().
   PoseEstimate pose() const;
   /// The pose mean alone, O(1): pose() factorizes Omega, which fills in as the map grows.
   const State& pose_mean() const { return x_; }
@@ -139,6 +143,7 @@ class SeifSlam {
   void atomically(Step step);
   void move_landmark_mean(std::size_t slot, const Eigen::Matrix<double, M, 1>& dm);
   void require_finite_robot_and_active(const char* what) const;
+  void require_factorizable_robot_and_active(const char* what) const;
   void recover_mean_exactly_in_transaction();
   void recover_mean_locally();
   void recover_mean_by_coordinate_descent();

@@ -3,6 +3,8 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "sextant/core/error.hpp"
@@ -40,6 +42,36 @@ Eigen::LLT<typename Derived::PlainObject> cholesky_or_throw(const Eigen::MatrixB
   Eigen::LLT<typename Derived::PlainObject> llt(a);
   if (llt.info() != Eigen::Success) throw numerical_error(what + " is not positive definite");
   return llt;
+}
+
+/// Throws numerical_error naming `what` unless the symmetric matrix a is positive definite and
+/// provably not numerically singular. a is scaled to unit diagonal (Cholesky does not care about
+/// diagonal scaling, so the scaled condition is the one that counts) and factorized; its pivots
+/// d_i = L_ii^2 lie in [lambda_min, lambda_max], so 1 / min d_i (the largest pivot is 1) is a lower
+/// bound of its condition number. If that exceeds 1 / (20 n^(3/2) u), Higham's bound for Cholesky
+/// to succeed (Accuracy and Stability of Numerical Algorithms, Thm 10.7), a is rejected. By
+/// eigenvalue interlacing a principal block is never worse conditioned than the whole matrix,
+/// so failing this on a block proves the whole matrix numerically singular; passing it proves
+/// nothing, but nothing sound is cheaper (O(n^3 / 3) for the small blocks it is used on).
+template <class Derived>
+void require_well_conditioned(const Eigen::MatrixBase<Derived>& a, const std::string& what) {
+  using Plain = typename Derived::PlainObject;
+  if (!a.allFinite()) throw numerical_error(what + " has NaN or Inf entries");
+  const auto diagonal = a.diagonal();
+  if (!(diagonal.array() > 0.0).all()) throw numerical_error(what + " is not positive definite");
+  const Eigen::VectorXd scale = diagonal.array().rsqrt().matrix();
+  const Plain scaled = scale.asDiagonal() * a * scale.asDiagonal();
+  const Eigen::LLT<Plain> llt(scaled);
+  if (llt.info() != Eigen::Success) throw numerical_error(what + " is not positive definite");
+  const double n = static_cast<double>(a.rows());
+  const double bound = 20.0 * n * std::sqrt(n) * Eigen::NumTraits<double>::epsilon();
+  const double smallest_pivot = llt.matrixLLT().diagonal().array().square().minCoeff();
+  if (!(smallest_pivot > bound)) {
+    char numbers[96];
+    std::snprintf(numbers, sizeof numbers, "its condition number is at least %.3g after scaling, above %.3g",
+                  1.0 / smallest_pivot, 1.0 / bound);
+    throw numerical_error(what + " is numerically singular (" + numbers + ")");
+  }
 }
 
 /// Squared Mahalanobis distance r^T A^-1 r given the Cholesky factor of A.

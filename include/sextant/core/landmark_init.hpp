@@ -11,13 +11,17 @@
 namespace sextant {
 
 /// sensor.initialize(x, z) for landmark `id`; throws numerical_error when the model returns NaN or
-/// Inf or a measurement noise Q that is not positive definite.
+/// Inf, a measurement noise Q that is not positive definite, or a landmark whose covariance from
+/// the measurement, J_m_z Q J_m_z^T, overflows (a range-bearing landmark at 1e300 m: r^2 sigma^2).
 template <class Sensor, class State, class Measurement>
 auto initialize_landmark(const Sensor& sensor, const State& x, const Measurement& z, LandmarkId id) {
   auto init = sensor.initialize(x, z);
   if (!init.m.allFinite() || !init.J_m_x.allFinite() || !init.J_m_z.allFinite() || !init.Q.allFinite())
     throw numerical_error("inverse measurement model returned NaN or Inf for landmark " + std::to_string(id));
   cholesky_or_throw(init.Q, "measurement noise Q of new landmark " + std::to_string(id));
+  if (!(init.J_m_z * init.Q * init.J_m_z.transpose()).allFinite())
+    throw numerical_error("covariance of new landmark " + std::to_string(id) +
+                          " overflows: it is measured too far away for the noise model");
   return init;
 }
 

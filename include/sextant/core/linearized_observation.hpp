@@ -3,9 +3,11 @@
 /// noise and the residual. Filters in moment and information form consume the same record.
 
 #include <Eigen/Core>
+#include <cmath>
 #include <string>
 
 #include "sextant/core/error.hpp"
+#include "sextant/core/gaussian.hpp"
 #include "sextant/core/observation.hpp"
 
 namespace sextant {
@@ -20,8 +22,12 @@ struct LinearizedObservation {
   Eigen::Matrix<double, Z, 1> residual; ///< z - h(x, m), wrapped by the model
 };
 
-/// Linearizes `sensor` at robot state x and landmark mean m for measurement z; throws
-/// numerical_error when the model returns NaN or Inf.
+/// Linearizes `sensor` at robot state x and landmark mean m for measurement z. Throws
+/// numerical_error when the model returns NaN or Inf, when Q is not positive definite, or when the
+/// squared residual weighted by Q^-1 overflows: a measurement that implausible (e.g. 1e300 m from
+/// its prediction, or a residual of 1 with sigma 1e-160) is rejected by every back-end, since
+/// no Gaussian update can use it (docs/reliability.md). A large but finite one is accepted
+/// unless the back-end's gate is on.
 template <class Sensor, class State, class Landmark, class Measurement>
 auto linearize_observation(const Sensor& sensor, const State& x, const Landmark& m, const Measurement& z,
                            LandmarkId id, Eigen::Index offset) {
@@ -34,6 +40,11 @@ auto linearize_observation(const Sensor& sensor, const State& x, const Landmark&
                                      sensor.residual(z, prediction.z)};
   if (!out.J_z_x.allFinite() || !out.J_z_m.allFinite() || !out.Q.allFinite() || !out.residual.allFinite())
     throw numerical_error("measurement model returned NaN or Inf for landmark " + std::to_string(id));
+  const auto llt = cholesky_or_throw(out.Q, "measurement noise Q of landmark " + std::to_string(id));
+  if (!std::isfinite(mahalanobis_squared(llt, out.residual)))
+    throw numerical_error("measurement of landmark " + std::to_string(id) +
+                          ": its squared residual weighted by Q^-1 overflows (the measurement is too far from "
+                          "its prediction for the noise model)");
   return out;
 }
 

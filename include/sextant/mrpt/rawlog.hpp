@@ -37,6 +37,7 @@
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/observation.hpp"
 #include "sextant/io/kf_slam_ground_truth.hpp"
+#include "sextant/mrpt/exception_text.hpp"
 #include "sextant/mrpt/rawlog_options.hpp"
 #include "sextant/models/range_bearing_2d.hpp"
 #include "sextant/models/range_bearing_3d.hpp"
@@ -71,18 +72,6 @@ enum class RawlogKind { planar, spatial };
 
 namespace detail {
 
-/// One line of an exception's text: MRPT's start with a banner, then "Message: ...", then a call
-/// trace; the message line is the one worth showing.
-inline std::string first_line(const std::string& text) {
-  std::size_t start = 0;
-  if (const auto message = text.find("Message:"); message != std::string::npos) start = message + 8;
-  std::string line = text.substr(start, text.find('\n', start) - start);
-  const auto first = line.find_first_not_of(" \t");
-  line = first == std::string::npos ? std::string() : line.substr(first);
-  while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
-  return line.empty() ? "unreadable data" : line;
-}
-
 /// Every serialized object of the file, in order.
 inline std::vector<::mrpt::serialization::CSerializable::Ptr> read_objects(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw parse_error(path + ": cannot open file (no such file)");
@@ -97,7 +86,7 @@ inline std::vector<::mrpt::serialization::CSerializable::Ptr> read_objects(const
     } catch (const std::exception& e) {
       if (in.getPosition() == start) break;  // nothing of a next entry: the end of the log
       throw parse_error(path + ": entry " + std::to_string(objects.size()) + ": truncated or malformed rawlog (" +
-                        first_line(e.what()) + ")");
+                        exception_message(e.what()) + ")");
     }
     if (!objects.back()) throw parse_error(path + ": entry " + std::to_string(objects.size() - 1) + ": empty object");
   }

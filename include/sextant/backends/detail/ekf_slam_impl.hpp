@@ -205,9 +205,15 @@ auto EkfSlam<Motion, Sensor>::plan(std::span<const ObservationType> known, std::
     x_after = out.correction->x;
     result.corrected += observations.size();
   }
+  // The corrected P_xx is below the current one, so P_mm = J_m_x P_xx J_m_x^T + J_m_z Q J_m_z^T finite
+  // with the current P_xx means finite after the correction too, and so are the cross terms
+  // (|P_m,j| <= sqrt(P_mm P_jj)): augment() in commit() cannot overflow.
+  const Eigen::Matrix<double, X, X> P_xx = symmetric_diagonal_block<X>(cov_.view(), 0);
   for (const auto& observation : fresh) {
-    out.new_landmarks.emplace_back(observation.landmark_id,
-                                   initialize_landmark(sensor_, x_after, observation.z, observation.landmark_id));
+    auto init = initialize_landmark(sensor_, x_after, observation.z, observation.landmark_id);
+    if (!(init.J_m_x * P_xx * init.J_m_x.transpose()).allFinite())
+      throw numerical_error("covariance of new landmark " + std::to_string(observation.landmark_id) + " overflows");
+    out.new_landmarks.emplace_back(observation.landmark_id, std::move(init));
   }
   result.initialized += out.new_landmarks.size();
   return out;

@@ -65,7 +65,8 @@ void FastSlam<Motion, Sensor, Map>::commit(Transaction&& t) {
 }
 
 /// FastSLAM 1.0 samples now; 2.0 keeps the motion pending for update()'s proposal (a second predict
-/// in a row samples the first one plainly). Either way every particle's motion is checked here.
+/// in a row samples the first one plainly). Either way every particle's motion is checked here,
+/// and so is the cloud's pose estimate (it overflows when the particles spread over 1e154).
 template <class Motion, class Sensor, template <class> class Map>
 void FastSlam<Motion, Sensor, Map>::predict(const Control& u, double dt) {
   require_finite(u, "control");
@@ -78,6 +79,7 @@ void FastSlam<Motion, Sensor, Map>::predict(const Control& u, double dt) {
     apply_pending_motion_v1(t);
   else
     for (const auto& particle : t.particles) checked_motion_prediction(motion_, particle.x, u, dt);
+  t.estimate = cloud_estimate(t.particles, t.pending);  // pose() after an accepted predict cannot throw
   commit(std::move(t));
 }
 

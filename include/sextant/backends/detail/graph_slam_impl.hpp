@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "sextant/core/landmark_init.hpp"
+#include "sextant/core/linearized_observation.hpp"
 #include "sextant/core/sparse_cholesky.hpp"
 #include "sextant/core/validation.hpp"
 
@@ -86,6 +87,7 @@ void GraphSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   const Eigen::Matrix<double, X, X> newest_cov =
       symmetrized(prediction.J_x_x * newest_cov_ * prediction.J_x_x.transpose() + prediction.R);
   if (!newest_cov.allFinite()) throw numerical_error("GraphSLAM: covariance of the new pose overflowed");
+  require_factorizable_extension(prior_.cov, prediction.J_x_x, prediction.R, "GraphSLAM: the new pose");
   motions_.push_back({u, dt});
   poses_.push_back(prediction.x);
   newest_cov_ = newest_cov;
@@ -97,16 +99,19 @@ UpdateResult GraphSlam<Motion, Sensor>::update(std::span<const ObservationType> 
   require_valid_observations(observations);
   const auto [known, fresh] = split_known_and_new(pool_, observations);
   const std::size_t pose = poses_.size() - 1;
-  // Check every new factor now, so that bad noise is reported where it enters, not at optimize().
-  for (const auto& observation : known) {
-    const auto prediction = sensor_.predict(poses_[pose], landmark_mean(pool_.slot(observation.landmark_id)));
-    cholesky_or_throw(prediction.Q, "measurement noise Q of landmark " + std::to_string(observation.landmark_id));
-  }
+  // Linearize every new factor at the current estimate now, so that a factor no later
+  // linearization could use (bad noise, an overflowing residual) is rejected where it enters
+  // instead of making every later optimize(), map() and landmark() throw.
+  for (const auto& observation : known)
+    linearize_observation(sensor_, poses_[pose], landmark_mean(pool_.slot(observation.landmark_id)), observation.z,
+                          observation.landmark_id, 0);
   std::vector<LandmarkInit<M, X, Z>> inits;
   for (const auto& observation : fresh) {
     inits.push_back(initialize_landmark(sensor_, poses_[pose], observation.z, observation.landmark_id));
-    cholesky_or_throw(sensor_.predict(poses_[pose], inits.back().m).Q,
-                      "measurement noise Q of landmark " + std::to_string(observation.landmark_id));
+    linearize_observation(sensor_, poses_[pose], inits.back().m, observation.z, observation.landmark_id, 0);
+    require_factorizable_extension(prior_.cov, inits.back().J_m_x,
+                                   symmetrized(inits.back().J_m_z * inits.back().Q * inits.back().J_m_z.transpose()),
+                                   "GraphSLAM: new landmark " + std::to_string(observation.landmark_id));
   }
   for (const auto& observation : known) measurements_[pool_.slot(observation.landmark_id)].push_back({pose, observation.z});
   for (std::size_t i = 0; i < fresh.size(); ++i) {
@@ -117,6 +122,27 @@ UpdateResult GraphSlam<Motion, Sensor>::update(std::span<const ObservationType> 
   }
   touch();
   return {known.size(), fresh.size(), {}};
+}
+
+/// A new variable y = J x + v, v ~ N(0, C), tied to the newest pose x (a pose by a motion factor,
+/// a landmark by its first measurement). The graph's only absolute information is the prior
+/// N(mu_0, P) (a relative factor cannot lift the gauge), so x is never known better than P
+/// carried along, and the system map() and optimize() factorize is at least as ill-conditioned as
+/// the joint covariance [P, P J^T; J P, J P J^T + C] of x and y. If that is numerically singular
+/// (sigma 1e-100 against a 1e-2 prior, a landmark at 1e150 m, a step of 1e100) so is the system:
+/// the variable is rejected here instead of making every later map() and optimize() throw.
+template <class Motion, class Sensor>
+template <int D>
+void GraphSlam<Motion, Sensor>::require_factorizable_extension(const Eigen::Matrix<double, X, X>& P,
+                                                               const Eigen::Matrix<double, D, X>& J,
+                                                               const Eigen::Matrix<double, D, D>& C,
+                                                               const std::string& what) {
+  Eigen::Matrix<double, X + D, X + D> joint;
+  joint.template topLeftCorner<X, X>() = P;
+  joint.template bottomLeftCorner<D, X>() = J * P;
+  joint.template topRightCorner<X, D>() = joint.template bottomLeftCorner<D, X>().transpose();
+  joint.template bottomRightCorner<D, D>() = symmetrized(J * P * J.transpose() + C);
+  require_well_conditioned(joint, what + ": its joint covariance with the newest pose");
 }
 
 /// The motion factor between poses k and k + 1: the model's own between() when it has one, else

@@ -25,9 +25,11 @@ SeifSlam<Motion, Sensor>::SeifSlam(Motion motion, Sensor sensor, const PoseEstim
 
 /// Thesis eqs. (20)-(26) in error-state form, with Phi = G^-T Omega G^-1 and
 /// T = (R^-1 + Phi_xx)^-1 = (I + R Phi_xx)^-1 R (no R^-1 needed):
-///   Omega_xx' = (I - Phi_xx T) Phi_xx,  Omega_xj' = (I - Phi_xx T) Phi_xj,  Omega_ij' = Omega_ij - Phi_xi^T T Phi_xj,
-///   r_x' = (I - Phi_xx T) G^-T r_x,     r_j' = r_j - Phi_xj^T T G^-T r_x,
-/// for the active landmarks i, j only; everything else is untouched.
+///   Omega_xx' = A Phi_xx,  Omega_xj' = A Phi_xj,  Omega_ij' = Omega_ij - Phi_xi^T T Phi_xj,
+///   r_x' = A G^-T r_x,     r_j' = r_j - Phi_xj^T T G^-T r_x,
+/// for the active landmarks i, j only; everything else is untouched. A = I - Phi_xx T is computed
+/// as (I + Phi_xx R)^-1, the same matrix without the cancellation that makes I - Phi_xx T garbage
+/// (and Omega indefinite) when R is large against Phi_xx^-1, e.g. after a long dt.
 template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   using MatrixX = Eigen::Matrix<double, X, X>;
@@ -41,7 +43,7 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   const MatrixX Phi_xx = symmetrized(G_inv_T * info_.robot() * G_inv_T.transpose());
   const MatrixX T = symmetrized(
       (MatrixX::Identity() + prediction.R * Phi_xx).partialPivLu().solve(prediction.R));
-  const MatrixX A = MatrixX::Identity() - Phi_xx * T;
+  const MatrixX A = (MatrixX::Identity() + Phi_xx * prediction.R).partialPivLu().solve(MatrixX::Identity());
   std::vector<std::pair<std::size_t, Eigen::Matrix<double, X, M>>> Phi_x;  // Phi_xj of the active landmarks
   Phi_x.reserve(info_.robot_links().size());
   for (const auto& [slot, block] : info_.robot_links()) Phi_x.emplace_back(slot, G_inv_T * block);
@@ -61,7 +63,7 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
         info_.add_to_link(i, Phi_x[b].first, -Phi_ix_T * Phi_x[b].second);
     }
     x_ = prediction.x;
-    require_finite_robot_and_active("SEIF motion update");
+    require_factorizable_robot_and_active("SEIF motion update");
   });
 }
 
@@ -146,7 +148,7 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
       recover_mean_locally();
     update_active_queue(observed);
     sparsify();
-    require_finite_robot_and_active("SEIF update");
+    require_factorizable_robot_and_active("SEIF update");
   });
   return {known.size(), fresh.size(), {}};
 }
@@ -195,6 +197,19 @@ void SeifSlam<Motion, Sensor>::require_finite_robot_and_active(const char* what)
     finite = finite && block.allFinite() && info_.diagonal(slot).allFinite() && info_.landmark_residual(slot).allFinite() &&
              landmark_mean(slot).allFinite();
   if (!finite) throw numerical_error(std::string(what) + ": the information form overflowed (NaN or Inf)");
+}
+
+/// A step leaves Omega positive definite in exact arithmetic; in floating point it may not, when
+/// it adds information far beyond what Omega holds (sigma 1e-100) or moves the robot by 1e100.
+/// The robot-and-active block is a principal block of Omega that every step touches: if it is
+/// numerically singular, so is Omega (require_well_conditioned), and pose() could not factorize it.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::require_factorizable_robot_and_active(const char* what) const {
+  require_finite_robot_and_active(what);
+  std::vector<std::size_t> slots;
+  for (const auto& [slot, block] : info_.robot_links()) slots.push_back(slot);
+  require_well_conditioned(robot_and_landmarks_block(slots),
+                           std::string(what) + ": the information of the robot and the active landmarks");
 }
 
 template <class Motion, class Sensor>

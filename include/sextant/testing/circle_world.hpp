@@ -1,6 +1,7 @@
 #pragma once
-// The benchmark world of the SEIF and FastSLAM benchmarks: n beacons on a circle one unit apart,
-// a ship sailing a circle 3 units inside, one beacon further per step, seeing the 4 nearest.
+/// \file The looping world of the SEIF and FastSLAM benchmarks and the soak test: n beacons on a
+/// circle one unit apart, a ship sailing a circle 3 units inside, one beacon further per step,
+/// seeing the 4 nearest. Noise-free: callers add their own.
 #include <malloc.h>
 
 #include <Eigen/Core>
@@ -11,7 +12,7 @@
 #include "sextant/core/observation.hpp"
 #include "sextant/models/beacon_ship_2d.hpp"
 
-namespace sextant::bench {
+namespace sextant::testing {
 
 /// Heap bytes in use (glibc): small blocks plus the mmapped large ones (a big covariance lives there).
 inline std::size_t heap_in_use() {
@@ -50,4 +51,4 @@ struct CircleWorld {
   double radius;
 };
 
-}  // namespace sextant::bench
+}  // namespace sextant::testing

@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# Runs every libFuzzer target in <build>/tests/fuzz for <seconds> each (./run.sh fuzz [seconds]).
+# Seed corpora are made here, at run time, from ../shared/data and MRPT's demo files (none are
+# committed), plus a small settings file of our own. Findings go to <build>/fuzz-findings/; the
+# summary (executions, coverage, findings) goes to stdout and <build>/fuzz-summary.md.
+set -uo pipefail
+build=$1
+seconds=${2:-60}
+root=$(cd "$(dirname "$0")/.." && pwd)
+shared=$root/../shared/data
+mrpt=/usr/share/mrpt
+corpus=$build/fuzz-corpus
+findings=$build/fuzz-findings
+mkdir -p "$findings"
+
+# seed <target> <file> [bytes]: copies the file (its first <bytes> bytes, cut at a line end) if it exists.
+seed() {
+  local dir=$corpus/$1 file=$2 bytes=${3:-}
+  mkdir -p "$dir"
+  [ -f "$file" ] || { echo "fuzz: seed $file not found, skipped"; return; }
+  if [ -n "$bytes" ]; then head -c "$bytes" "$file" | sed '$d' > "$dir/$(basename "$file")"; else cp "$file" "$dir/"; fi
+}
+seed isam_reader_fuzz "$shared/city_trees/cityTrees10000.txt" 4096
+seed isam_reader_fuzz "$shared/city_trees/cityTrees10000_groundtruth.txt" 4096
+seed isam_reader_fuzz "$shared/victoria_park/victoria_park.txt" 4096
+for f in "$mrpt"/datasets/kf-slam_*ground_truth*.txt; do seed kf_slam_ground_truth_fuzz "$f" 4096; done
+for f in "$mrpt"/datasets/kf-slam_demo.rawlog "$mrpt"/datasets/kf-slam_6D_demo.rawlog; do seed rawlog_fuzz "$f"; done
+for f in "$mrpt"/config_files/kf-slam/EKF-SLAM_test_2d.ini "$mrpt"/config_files/kf-slam/EKF-SLAM_6D_test.ini; do
+  seed runner_config_fuzz "$f"
+done
+mkdir -p "$corpus/runner_config_fuzz"
+printf '[ship]\nruns = 2\nsigma_heading_deg = 15\n[ekf]\ncovariance_update = joseph\n[seif]\nmax_active = 4 // four\n[globe]\nseif_active = 4 8\n' \
+  > "$corpus/runner_config_fuzz/sextant.ini"
+
+summary=$build/fuzz-summary.md
+{
+  echo "| target | seconds | executions | coverage (edges) | features | corpus | findings |"
+  echo "|---|---|---|---|---|---|---|"
+} > "$summary"
+status=0
+for target in "$build"/tests/fuzz/*_fuzz; do
+  name=$(basename "$target")
+  mkdir -p "$corpus/$name"
+  log=$build/fuzz-$name.log
+  echo "fuzz: $name for $seconds s"
+  "$target" "$corpus/$name" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2560 -max_len=65536 \
+    -print_final_stats=1 -artifact_prefix="$findings/$name-" > "$log" 2>&1
+  rc=$?
+  execs=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$log" | awk '{print $2}')
+  cov=$(grep -oE '(DONE|pulse|REDUCE|NEW|INITED) +cov: [0-9]+' "$log" | tail -1 | awk '{print $NF}')
+  ft=$(grep -oE ' ft: [0-9]+' "$log" | tail -1 | awk '{print $NF}')
+  units=$(ls "$corpus/$name" | wc -l)
+  found=$(ls "$findings" | grep -c "^$name-" || true)
+  echo "| $name | $seconds | ${execs:-?} | ${cov:-?} | ${ft:-?} | $units | $found |" >> "$summary"
+  if [ $rc -ne 0 ] || [ "$found" -ne 0 ]; then
+    status=1
+    echo "fuzz: $name FAILED (exit $rc); its log: $log"
+    grep -E "ERROR|runtime error|SUMMARY|uncaught|Test unit written" "$log" | head -20
+  fi
+done
+cat "$summary"
+exit $status
