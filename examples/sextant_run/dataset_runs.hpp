@@ -19,4 +19,8 @@ std::vector<TableRow> run_ship(const RunOptions& options, const std::vector<Back
 /// The simulated globe: the 12D camera, every back-end through the landmark pool (run_globe.cpp).
 std::vector<TableRow> run_globe(const RunOptions& options, const std::vector<BackendKind>& kinds, const RunnerConfig& config);
 
+/// One or all robots of a UTIAS MRCLAM data set, spec "<directory>:<robot 1-5 | all>" (run_mrclam.cpp).
+std::vector<TableRow> run_mrclam(const RunOptions& options, const std::string& spec, const std::vector<BackendKind>& kinds,
+                                 const RunnerConfig& config);
+
 }  // namespace sextant::runner

@@ -93,8 +93,9 @@ int main(int argc, char** argv) {
                        const auto kinds = parse_backends(options.backends);
                        std::vector<TableRow> rows;
                        for (const auto& dataset : expand_datasets(options.datasets)) {
-                         auto part = dataset == "ship" ? run_ship(options.output, kinds, config)
-                                                       : run_rawlog(options, dataset, kinds, config);
+                         auto part = dataset == "ship"                ? run_ship(options.output, kinds, config)
+                                     : dataset.rfind("mrclam:", 0) == 0 ? run_mrclam(options.output, dataset.substr(7), kinds, config)
+                                                                        : run_rawlog(options, dataset, kinds, config);
                          rows.insert(rows.end(), part.begin(), part.end());
                        }
                        finish_run(options, rows);

@@ -29,7 +29,8 @@ inline void add_runner_options(CLI::App& app, CliOptions& options) {
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--dataset,-d", options.datasets,
-                 "ship | globe | mrpt-demos | <file.rawlog> (repeatable; default: ship and the MRPT kf-slam demos)");
+                 "ship | globe | mrpt-demos | <file.rawlog> | mrclam:<dir>:<robot 1-5|all> (repeatable; default: ship and the "
+                 "MRPT kf-slam demos)");
   app.add_option("--config,-c", options.config, "ini file (MRPT CConfigFile) with [ship] [globe] [rawlog] [ekf] [seif] [graph] "
                                                 "[fastslam] [scene] keys; see --print-config");
   app.add_option("--out,-o", options.output.out, "directory for per-step CSV, TUM, .3Dscene files and summary.json");

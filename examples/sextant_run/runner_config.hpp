@@ -18,6 +18,7 @@
 #include <sextant/backends/graph_slam.hpp>
 #include <sextant/backends/seif_slam.hpp>
 #include <sextant/core/error.hpp>
+#include <sextant/io/mrclam_reader.hpp>
 #include <sextant/io/parse_number.hpp>
 #include <sextant/mrpt/exception_text.hpp>
 #include <sextant/mrpt/rawlog_options.hpp>
@@ -51,6 +52,7 @@ struct RunnerConfig {
   GraphOptions graph;
   FastSlamOptions fastslam{.particles = 100, .resample_threshold = 0.1, .map_estimate = FastSlamMap::weighted_average};
   GlobeSettings globe;
+  io::MrclamOptions mrclam;
   double scene_quantile = 3.0;
 };
 
@@ -99,6 +101,13 @@ inline std::string without_comment(std::string value) {
   const auto first = value.find_first_not_of(" \t\r");
   const auto last = value.find_last_not_of(" \t\r");
   return first == std::string::npos ? std::string() : value.substr(first, last - first + 1);
+}
+
+/// A gate probability: 0 (off) or in (0, 1).
+inline double parse_gate_probability(const std::string& text) {
+  const double p = parse_number(text);
+  if (p < 0.0 || p >= 1.0) throw invalid_input_error("'" + text + "' must be in [0, 1)");
+  return p;
 }
 
 template <class Enum>
@@ -177,6 +186,23 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.rawlog.prior_std = positive(parse_number(v), v); }},
       {"rawlog", "max_steps", "0", "read at most this many steps; 0 = all",
        [](RunnerConfig& c, const std::string& v) { c.rawlog.max_steps = parse_integer<std::size_t>(v, 0); }},
+      {"mrclam", "max_step", "0.25", "MRCLAM: longest step without a measurement, s (steps also end at every measurement)",
+       [](RunnerConfig& c, const std::string& v) { c.mrclam.max_step = positive(parse_number(v), v); }},
+      {"mrclam", "std_range", "0.15", "MRCLAM: range noise, m (robust SD against Vicon: 0.13)",
+       [](RunnerConfig& c, const std::string& v) { c.mrclam.measurement_sigma(0) = positive(parse_number(v), v); }},
+      {"mrclam", "std_bearing_deg", "1.146", "MRCLAM: bearing noise, degrees (robust SD against Vicon: 0.49)",
+       [](RunnerConfig& c, const std::string& v) { c.mrclam.measurement_sigma(1) = positive(parse_number(v), v) * deg; }},
+      {"mrclam", "alpha", "0.015 0.002 0.02 0.1 0 0.001",
+       "MRCLAM: velocity motion model noise a1..a6 (Thrun): var v = a1 v^2 + a2 w^2, var w = a3 v^2 + a4 w^2, final "
+       "turn a5 v^2 + a6 w^2",
+       [](RunnerConfig& c, const std::string& v) {
+         std::istringstream in(v);
+         std::vector<double> values;
+         for (std::string word; in >> word;) values.push_back(parse_number(word));
+         if (values.size() != 6 || std::any_of(values.begin(), values.end(), [](double a) { return a < 0.0; }))
+           throw invalid_input_error("'" + v + "' must be six non-negative numbers");
+         std::copy(values.begin(), values.end(), c.mrclam.motion.alpha.begin());
+       }},
       {"ekf", "batch_update", "true", "one joint correction per step (true) or one per observation (false)",
        [](RunnerConfig& c, const std::string& v) { c.ekf.batch_update = parse_bool(v); }},
       {"ekf", "covariance_update", "symmetric", "symmetric (lower-triangle rank update) | joseph",
@@ -185,11 +211,10 @@ inline const std::vector<ConfigKey>& config_keys() {
              parse_choice<CovarianceUpdate>(v, {{"symmetric", CovarianceUpdate::symmetric}, {"joseph", CovarianceUpdate::joseph}});
        }},
       {"ekf", "gate_probability", "0", "Mahalanobis gate: reject observations above this chi-square quantile; 0 = off",
-       [](RunnerConfig& c, const std::string& v) {
-         const double p = parse_number(v);
-         if (p < 0.0 || p >= 1.0) throw invalid_input_error("'" + v + "' must be in [0, 1)");
-         c.ekf.gate_probability = p;
-       }},
+       [](RunnerConfig& c, const std::string& v) { c.ekf.gate_probability = parse_gate_probability(v); }},
+      {"seif", "gate_probability", "0",
+       "Mahalanobis gate with the exact marginals (one factorization per update); 0 = off",
+       [](RunnerConfig& c, const std::string& v) { c.seif.gate_probability = parse_gate_probability(v); }},
       {"seif", "max_active", "8", "landmarks kept linked to the robot by sparsification; 0 = no sparsification",
        [](RunnerConfig& c, const std::string& v) { c.seif.max_active = parse_integer<std::size_t>(v, 0); }},
       {"seif", "mean_recovery", "active_block", "active_block (joint solve) | coordinate_descent (thesis)",
@@ -201,6 +226,13 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.seif.mean_recovery_sweeps = parse_integer<int>(v, 0); }},
       {"seif", "exact_recovery_period", "0", "every K updates an exact solve of the whole mean; 0 = never",
        [](RunnerConfig& c, const std::string& v) { c.seif.exact_recovery_period = parse_integer<int>(v, 0); }},
+      {"graph", "robust_kernel", "none", "none | huber | cauchy, on measurement factors",
+       [](RunnerConfig& c, const std::string& v) {
+         c.graph.measurement_loss.kernel = parse_choice<RobustKernel>(
+             v, {{"none", RobustKernel::none}, {"huber", RobustKernel::huber}, {"cauchy", RobustKernel::cauchy}});
+       }},
+      {"graph", "kernel_width", "2.4477", "robust kernel width, standard deviations of the whitened residual",
+       [](RunnerConfig& c, const std::string& v) { c.graph.measurement_loss.width = positive(parse_number(v), v); }},
       {"graph", "max_iterations", "10", "Gauss-Newton iterations at most",
        [](RunnerConfig& c, const std::string& v) { c.graph.max_iterations = parse_integer<int>(v, 1); }},
       {"graph", "solver", "automatic", "automatic | landmark_schur (thesis) | full (sparse Cholesky of everything)",
@@ -213,6 +245,8 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.graph.levenberg_marquardt = parse_bool(v); }},
       {"graph", "window", "0", "windowed initialization: optimize growing parts of this many steps first; 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.graph.window = parse_integer<std::size_t>(v, 0); }},
+      {"fastslam", "gate_probability", "0", "per-particle Mahalanobis gate on known landmarks; 0 = off",
+       [](RunnerConfig& c, const std::string& v) { c.fastslam.gate_probability = parse_gate_probability(v); }},
       {"fastslam", "particles", "100", "particles",
        [](RunnerConfig& c, const std::string& v) { c.fastslam.particles = parse_integer<std::size_t>(v, 1); }},
       {"fastslam", "resample_threshold", "0.1", "resample when N_eff < threshold * particles (1 = always, 0 = never)",

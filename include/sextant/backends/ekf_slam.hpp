@@ -9,6 +9,7 @@
 
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/gaussian.hpp"
+#include "sextant/core/innovation_gate.hpp"
 #include "sextant/core/landmark_pool.hpp"
 #include "sextant/core/linearized_observation.hpp"
 #include "sextant/core/symmetric_matrix.hpp"
@@ -125,7 +126,7 @@ class EkfSlam {
   Motion motion_;
   Sensor sensor_;
   EkfOptions options_;
-  double gate_threshold_ = 0.0;
+  InnovationGate gate_;
   State x_;
   Eigen::VectorXd landmark_means_;
   GrowableSquareMatrix cov_;  ///< P; only its lower triangle is kept up to date

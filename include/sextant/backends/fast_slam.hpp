@@ -12,6 +12,7 @@
 
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/gaussian.hpp"
+#include "sextant/core/innovation_gate.hpp"
 #include "sextant/core/persistent_array.hpp"
 #include "sextant/core/update_result.hpp"
 
@@ -42,6 +43,11 @@ struct FastSlamOptions {
   /// Ids given to the landmarks that particles create in update_unassociated: first, first + 1, ...
   /// A landmark keeps its id in every particle that descends from the one that created it.
   LandmarkId first_unassociated_id = LandmarkId{1} << 62;
+  /// In (0, 1), per particle: an observation of a known landmark whose innovation fails the
+  /// chi-square test (core/innovation_gate.hpp) is not applied to that particle's landmark and
+  /// weighs as a measurement on the gate's edge, like a new landmark. UpdateResult::rejected lists
+  /// the observations the most likely particle rejected. 0 = off.
+  double gate_probability = 0.0;
 };
 
 /// One landmark of one particle: an EKF over its position (eqs. 75-78).
@@ -137,9 +143,17 @@ class FastSlam {
 
   static State sample(const State& mean, const Eigen::Matrix<double, X, X>& cov, std::mt19937_64& rng);
   void apply_pending_motion_v1(Transaction& t) const;
-  double update_landmark(Particle& particle, std::size_t index, const Measurement& z, bool unassociated) const;
-  void sample_v2_proposal(Particle& particle, const State& predicted, const Eigen::Matrix<double, X, X>& R,
-                          std::span<const ObservationType> known, std::mt19937_64& rng) const;
+  /// What one landmark update adds to the particle's log weight, and whether the gate rejected it.
+  struct LandmarkUpdate {
+    double log_likelihood;
+    bool rejected;
+  };
+  LandmarkUpdate update_landmark(Particle& particle, std::size_t index, const Measurement& z, bool unassociated,
+                                 bool gated) const;
+  template <class Llt>
+  double log_likelihood_at_gate_edge(const Llt& llt) const;
+  std::vector<char> sample_v2_proposal(Particle& particle, const State& predicted, const Eigen::Matrix<double, X, X>& R,
+                                       std::span<const ObservationType> known, std::mt19937_64& rng) const;
   void normalize_and_resample(Transaction& t) const;
   PoseEstimate cloud_estimate(const std::vector<Particle>& cloud, const std::vector<PendingMotion>& pending) const;
   static std::vector<double> normalized_weights(const std::vector<Particle>& particles);
@@ -155,6 +169,7 @@ class FastSlam {
   Motion motion_;
   Sensor sensor_;
   FastSlamOptions options_;
+  InnovationGate gate_;
   std::vector<Particle> particles_;
   std::unordered_map<LandmarkId, std::size_t> index_;  ///< id -> index in every particle's map
   std::vector<LandmarkId> id_of_index_;  ///< index -> id; an index whose id was removed is stale

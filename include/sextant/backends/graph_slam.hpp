@@ -13,6 +13,7 @@
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/landmark_pool.hpp"
+#include "sextant/core/robust_kernel.hpp"
 #include "sextant/core/selected_inverse.hpp"
 #include "sextant/core/sparse_cholesky.hpp"
 #include "sextant/core/update_result.hpp"
@@ -44,6 +45,9 @@ struct GraphOptions {
   std::size_t window = 0;      ///< thesis §4.2.2: before the first full optimization, optimize growing
                                ///< sub-parts of `window` steps (0 = dead-reckoning initialization only)
   int window_iterations = 5;   ///< Gauss-Newton iterations per sub-part
+  /// On measurement factors (outliers of a real sensor): Huber or Cauchy by iteratively reweighted
+  /// Gauss-Newton (core/robust_kernel.hpp); none = plain least squares. Motion factors stay quadratic.
+  RobustLoss measurement_loss{};
 };
 
 /// What optimize() reports.

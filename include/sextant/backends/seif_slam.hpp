@@ -13,6 +13,7 @@
 
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/gaussian.hpp"
+#include "sextant/core/innovation_gate.hpp"
 #include "sextant/core/landmark_pool.hpp"
 #include "sextant/core/linearized_observation.hpp"
 #include "sextant/core/sparse_cholesky.hpp"
@@ -36,6 +37,11 @@ struct SeifOptions {
   MeanRecovery mean_recovery = MeanRecovery::active_block;
   int mean_recovery_sweeps = 1;   ///< sweeps per update (0 = none)
   int exact_recovery_period = 0;  ///< every K updates, an exact sparse solve of the whole mean; 0 = never
+  /// In (0, 1): reject observations whose innovation fails the chi-square test at this probability
+  /// (core/innovation_gate.hpp), with S from the exact joint marginal of the robot and the landmark.
+  /// That costs one sparse factorization of Omega per update: with the gate on, an update is no
+  /// longer constant time. 0 = off.
+  double gate_probability = 0.0;
 };
 
 /// SEIF-SLAM in error-state information form: Omega (block-sparse) and r = xi - Omega mu at the
@@ -127,6 +133,7 @@ class SeifSlam {
   Landmark landmark_mean(std::size_t slot) const { return landmark_means_.template segment<M>(M * slot); }
 
   MeasurementInformation measurement_information(const ObservationType& observation) const;
+  std::vector<ObservationType> gate(std::vector<ObservationType> known, std::vector<LandmarkId>& rejected) const;
   NewLandmark new_landmark(const ObservationType& observation) const;
   void add(const MeasurementInformation& info);
   void augment(const NewLandmark& landmark);
@@ -158,6 +165,7 @@ class SeifSlam {
   Motion motion_;
   Sensor sensor_;
   SeifOptions options_;
+  InnovationGate gate_;
   State x_;
   Eigen::VectorXd landmark_means_;
   SparseInformation<X, M> info_;

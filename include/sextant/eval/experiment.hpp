@@ -151,6 +151,7 @@ RunSummary<typename Backend::State> evaluate_smoothed_run(Backend& backend, cons
 /// average (time_averaged_anees_interval).
 struct Summary {
   double pose_mae = 0.0, map_mae = 0.0, map_mae_over_time = 0.0;
+  double pose_rmse = 0.0;  ///< root mean square of the position error over the steps, averaged over runs
   double pose_mae_aligned = 0.0, map_mae_aligned = 0.0;  ///< after rigid alignment to the truth
   double pose_nees_inside = 0.0, map_nees_inside = 0.0;  ///< fractions in [0, 1]
   double total_seconds = 0.0, seconds_per_step = 0.0;
@@ -168,6 +169,7 @@ Summary summarize(const std::vector<RunSummary<State>>& runs, int pose_dof, int 
   std::vector<double> pose_maes, map_maes, nees_averages;
   for (const auto& r : runs) {
     pose_maes.push_back(mean(r.pose_error));
+    s.pose_rmse += rms(r.pose_error) / n;
     map_maes.push_back(mean(r.map_error));
     s.pose_nees_inside += fraction_at_most(r.pose_nees, nees_upper_bound(pose_dof, confidence)) / n;
     s.map_nees_inside += fraction_at_most(r.map_nees, nees_upper_bound(landmark_dof, confidence)) / n;

@@ -37,6 +37,7 @@
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/observation.hpp"
 #include "sextant/io/kf_slam_ground_truth.hpp"
+#include "sextant/io/landmark_dataset.hpp"
 #include "sextant/mrpt/exception_text.hpp"
 #include "sextant/mrpt/rawlog_options.hpp"
 #include "sextant/models/range_bearing_2d.hpp"
@@ -50,19 +51,7 @@ namespace sextant::mrpt_io {
 
 /// A rawlog as a step stream with the models configured from it; ground truth when attached.
 template <class MotionT, class SensorT>
-struct RawlogDataset {
-  using Motion = MotionT;
-  using Sensor = SensorT;
-  using State = typename Motion::State;
-  std::string path;
-  Motion motion;
-  Sensor sensor;
-  Gaussian<State, Motion::kDim> prior;
-  std::vector<Step<typename Motion::Control, typename Sensor::Measurement>> steps;
-  std::vector<State> true_poses;  ///< [k]: after step k, [0] the start; empty without ground truth
-  std::map<LandmarkId, typename Sensor::Landmark> true_landmarks;
-  bool has_ground_truth() const { return !true_poses.empty(); }
-};
+using RawlogDataset = io::LandmarkDataset<MotionT, SensorT>;
 
 using RawlogDataset2D = RawlogDataset<Se2Odometry, RangeBearing2D>;
 using RawlogDataset3D = RawlogDataset<Se3Odometry, RangeBearing3D>;

@@ -5,7 +5,6 @@
 #include <string>
 #include <utility>
 
-#include "sextant/core/chi_square.hpp"
 #include "sextant/core/landmark_init.hpp"
 #include "sextant/core/validation.hpp"
 
@@ -16,7 +15,7 @@ EkfSlam<Motion, Sensor>::EkfSlam(Motion motion, Sensor sensor, const PoseEstimat
     : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), x_(prior.mean), cov_(X) {
   if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
   cholesky_or_throw(prior.cov, "prior covariance");
-  if (options_.gate_probability != 0.0) gate_threshold_ = chi_square_quantile(Z, options_.gate_probability);
+  gate_ = InnovationGate(Z, options_.gate_probability);
   cov_.view() = symmetrized(prior.cov);
 }
 
@@ -85,17 +84,17 @@ auto EkfSlam<Motion, Sensor>::cross_covariance(const Linearized& obs) const -> E
          symmetric_column_block<M>(P, obs.offset) * obs.J_z_m.transpose();
 }
 
-/// Removes observations whose innovation is implausible: nu^T S^-1 nu > chi2_Z(gate_probability).
+/// Removes observations whose innovation fails the chi-square test (core/innovation_gate.hpp).
 template <class Motion, class Sensor>
 void EkfSlam<Motion, Sensor>::gate(std::vector<Linearized>& observations, UpdateResult& result) const {
-  if (gate_threshold_ <= 0.0) return;
+  if (!gate_.on()) return;
   std::vector<Linearized> kept;
   for (auto& obs : observations) {
     const auto C = cross_covariance(obs);
     const Eigen::Matrix<double, Z, Z> S = symmetrized(
         obs.J_z_x * C.template topRows<X>() + obs.J_z_m * C.template middleRows<M>(obs.offset) + obs.Q);
     const auto llt = cholesky_or_throw(S, "innovation covariance of landmark " + std::to_string(obs.id));
-    if (mahalanobis_squared(llt, obs.residual) > gate_threshold_)
+    if (gate_.rejects(llt, obs.residual))
       result.rejected.push_back(obs.id);
     else
       kept.push_back(std::move(obs));

@@ -34,6 +34,7 @@ FastSlam<Motion, Sensor, Map>::FastSlam(Motion motion, Sensor sensor, const Pose
     throw invalid_input_error("FastSlamOptions: resample_threshold must be in [0, 1]");
   if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
   cholesky_or_throw(prior.cov, "prior covariance");
+  gate_ = InnovationGate(Z, options_.gate_probability);
   particles_.resize(options_.particles);
   for (auto& particle : particles_) particle.x = sample(prior.mean, prior.cov, rng_);
 }
@@ -94,17 +95,27 @@ void FastSlam<Motion, Sensor, Map>::apply_pending_motion_v1(Transaction& t) cons
   t.pending.clear();
 }
 
-/// One landmark EKF update with the particle's pose (eqs. 75-78, Joseph form); returns the log
-/// likelihood log N(nu; 0, S), S = H_m Sigma_m H_m^T + Q (eqs. 79-81).
+/// The weight of a measurement on the gate's edge, log N at NIS = threshold: what a rejected
+/// observation (or a new landmark) contributes, so that an outlier neither ruins nor favours a particle.
 template <class Motion, class Sensor, template <class> class Map>
-double FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::size_t index, const Measurement& z,
-                                                      bool unassociated) const {
+template <class Llt>
+double FastSlam<Motion, Sensor, Map>::log_likelihood_at_gate_edge(const Llt& llt) const {
+  return detail::log_gaussian(llt, Eigen::Matrix<double, Z, 1>::Zero().eval()) - 0.5 * gate_.threshold();
+}
+
+/// One landmark EKF update with the particle's pose (eqs. 75-78, Joseph form); returns the log
+/// likelihood log N(nu; 0, S), S = H_m Sigma_m H_m^T + Q (eqs. 79-81). With `gated` and the gate
+/// on, an innovation that fails the chi-square test leaves the landmark as it is.
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::size_t index, const Measurement& z,
+                                                    bool unassociated, bool gated) const -> LandmarkUpdate {
   auto& map = unassociated ? particle.unassociated : particle.landmarks;
   const LandmarkGaussian<M>& L = map[index];
   const auto pred = sensor_.predict(particle.x, L.mean);
   const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(z, pred.z);
   const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
   const auto llt = cholesky_or_throw(S, "landmark innovation covariance");
+  if (gated && gate_.rejects(llt, nu)) return {log_likelihood_at_gate_edge(llt), true};
   const Eigen::Matrix<double, M, Z> K = llt.solve(pred.J_z_m * L.cov).transpose();
   const Eigen::Matrix<double, M, M> I_KH = Eigen::Matrix<double, M, M>::Identity() - K * pred.J_z_m;
   LandmarkGaussian<M> updated{L.mean + K * nu, symmetrized(I_KH * L.cov * I_KH.transpose() + K * pred.Q * K.transpose()),
@@ -113,27 +124,35 @@ double FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::s
   if (!updated.mean.allFinite() || !updated.cov.allFinite() || !std::isfinite(log_likelihood))
     throw numerical_error("landmark update is not finite");
   map.set(index, std::move(updated));
-  return log_likelihood;
+  return {log_likelihood, false};
 }
 
 /// FastSLAM 2.0 proposal (eqs. 82-92), in Kalman form so that R may be singular: starting from
 /// N(g(x, u), R), each observation of a known landmark corrects the pose Gaussian with
 /// S = H_x Sigma H_x^T + H_m Sigma_m H_m^T + Q; the weight gains log N(nu; 0, S) (eq. 93, chained
-/// over the observations); the pose is then sampled from the result.
+/// over the observations); the pose is then sampled from the result. An observation that fails the
+/// gate does not shape the proposal and weighs as on the gate's edge; the result flags it.
 template <class Motion, class Sensor, template <class> class Map>
-void FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const State& predicted,
+std::vector<char> FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const State& predicted,
                                                        const Eigen::Matrix<double, X, X>& R,
                                                        std::span<const ObservationType> known,
                                                        std::mt19937_64& rng) const {
   State mean = predicted;
   Eigen::Matrix<double, X, X> cov = R;
-  for (const auto& observation : known) {
+  std::vector<char> rejected(known.size(), 0);
+  for (std::size_t i = 0; i < known.size(); ++i) {
+    const auto& observation = known[i];
     const LandmarkGaussian<M>& L = particle.landmarks[index_.at(observation.landmark_id)];
     const auto pred = sensor_.predict(mean, L.mean);
     const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(observation.z, pred.z);
     const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_x * cov * pred.J_z_x.transpose() +
                                                       pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
     const auto llt = cholesky_or_throw(S, "proposal innovation covariance");
+    if (gate_.rejects(llt, nu)) {
+      particle.log_weight += log_likelihood_at_gate_edge(llt);
+      rejected[i] = 1;
+      continue;
+    }
     const Eigen::Matrix<double, X, Z> K = llt.solve(pred.J_z_x * cov).transpose();
     particle.log_weight += detail::log_gaussian(llt, nu);
     mean = Space::plus(mean, K * nu);
@@ -141,6 +160,7 @@ void FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const
   }
   if (!std::isfinite(particle.log_weight)) throw numerical_error("FastSLAM 2.0 proposal weight is not finite");
   particle.x = sample(mean, cov, rng);
+  return rejected;
 }
 
 /// Every step works on a copy of the particles (O(N) with shared maps) and of the random engine,
@@ -153,14 +173,20 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
     (index_.contains(observation.landmark_id) ? known : fresh).push_back(observation);
   Transaction t = begin();
   const bool proposal = options_.version == FastSlamVersion::v2 && !t.pending.empty();
-  for (auto& particle : t.particles) {
+  std::vector<std::vector<char>> rejected(t.particles.size());
+  for (std::size_t n = 0; n < t.particles.size(); ++n) {
+    auto& particle = t.particles[n];
     if (proposal) {
       const auto p = checked_motion_prediction(motion_, particle.x, t.pending.back().u, t.pending.back().dt);
-      sample_v2_proposal(particle, p.x, p.R, known, t.rng);
-      for (const auto& observation : known) update_landmark(particle, index_.at(observation.landmark_id), observation.z, false);
+      rejected[n] = sample_v2_proposal(particle, p.x, p.R, known, t.rng);
+      for (std::size_t i = 0; i < known.size(); ++i)
+        if (!rejected[n][i]) update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false, false);
     } else {
-      for (const auto& observation : known)
-        particle.log_weight += update_landmark(particle, index_.at(observation.landmark_id), observation.z, false);
+      for (const auto& observation : known) {
+        const auto result = update_landmark(particle, index_.at(observation.landmark_id), observation.z, false, true);
+        particle.log_weight += result.log_likelihood;
+        rejected[n].push_back(result.rejected);
+      }
     }
     for (const auto& observation : fresh) {
       const auto init = initialize_landmark(sensor_, particle.x, observation.z, observation.landmark_id);
@@ -169,6 +195,11 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
     }
   }
   t.pending.clear();
+  UpdateResult result{0, fresh.size(), {}};
+  const auto& best_rejected = rejected[best_particle(t.particles)];
+  for (std::size_t i = 0; i < known.size(); ++i)
+    if (i < best_rejected.size() && best_rejected[i]) result.rejected.push_back(known[i].landmark_id);
+  result.corrected = known.size() - result.rejected.size();
   normalize_and_resample(t);
   auto index = index_;
   auto id_of_index = id_of_index_;
@@ -179,7 +210,7 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
   commit(std::move(t));
   index_.swap(index);
   id_of_index_.swap(id_of_index);
-  return {known.size(), fresh.size(), {}};
+  return result;
 }
 
 /// Thesis §7.2: per particle, each measurement goes to the landmark of that particle with the
@@ -233,7 +264,7 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
     particle.x = proposal ? sample(mean, cov, t.rng) : mean;
     for (std::size_t i = 0; i < measurements.size(); ++i) {
       if (match[i] != kNew) {
-        const double log_likelihood = update_landmark(particle, match[i], measurements[i], true);
+        const double log_likelihood = update_landmark(particle, match[i], measurements[i], true, false).log_likelihood;
         if (!proposal) particle.log_weight += log_likelihood;
         continue;
       }

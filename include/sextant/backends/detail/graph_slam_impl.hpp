@@ -73,6 +73,7 @@ GraphSlam<Motion, Sensor>::GraphSlam(Motion motion, Sensor sensor, const PoseEst
       cholesky_or_throw(prior.cov, "prior covariance").solve(Eigen::Matrix<double, X, X>::Identity()));
   if (options_.max_iterations < 1 || options_.window_iterations < 1)
     throw invalid_input_error("GraphOptions: max_iterations and window_iterations must be >= 1");
+  options_.measurement_loss.validate();
   poses_.push_back(prior.mean);
 }
 
@@ -215,15 +216,17 @@ auto GraphSlam<Motion, Sensor>::linearize(std::size_t pose_count) const -> Linea
       const auto prediction = sensor_.predict(poses_[record.pose], landmark_mean(slot));
       const Eigen::Matrix<double, Z, 1> r = -sensor_.residual(record.z, prediction.z);
       const auto llt = cholesky_or_throw(prediction.Q, "measurement noise Q of landmark " + std::to_string(pool_.id_at(slot)));
-      const Eigen::Matrix<double, Z, X> W_Jx = llt.solve(prediction.J_z_x);
-      const Eigen::Matrix<double, Z, M> W_Jm = llt.solve(prediction.J_z_m);
-      const Eigen::Matrix<double, Z, 1> W_r = llt.solve(r);
+      const double s = r.dot(llt.solve(r));
+      const double w = options_.measurement_loss.weight(s);  // IRLS: rho'(s) W
+      const Eigen::Matrix<double, Z, X> W_Jx = w * llt.solve(prediction.J_z_x);
+      const Eigen::Matrix<double, Z, M> W_Jm = w * llt.solve(prediction.J_z_m);
+      const Eigen::Matrix<double, Z, 1> W_r = w * llt.solve(r);
       sys.pose_diagonal[record.pose] += prediction.J_z_x.transpose() * W_Jx;
       rhs(record.pose) -= prediction.J_z_x.transpose() * W_r;
       terms.diagonal += prediction.J_z_m.transpose() * W_Jm;
       terms.rhs -= prediction.J_z_m.transpose() * W_r;
       terms.poses.emplace_back(record.pose, prediction.J_z_x.transpose() * W_Jm);
-      sys.cost += r.dot(W_r);
+      sys.cost += options_.measurement_loss.cost(s);
     }
     if (!terms.poses.empty()) sys.landmarks.push_back(std::move(terms));
   }

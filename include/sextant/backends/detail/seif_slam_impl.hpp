@@ -21,6 +21,7 @@ SeifSlam<Motion, Sensor>::SeifSlam(Motion motion, Sensor sensor, const PoseEstim
   info_.robot() = symmetrized(llt.solve(Eigen::Matrix<double, X, X>::Identity()));
   if (options_.mean_recovery_sweeps < 0 || options_.exact_recovery_period < 0)
     throw invalid_input_error("SeifOptions: mean_recovery_sweeps and exact_recovery_period must be >= 0");
+  gate_ = InnovationGate(Z, options_.gate_probability);
 }
 
 /// Thesis eqs. (20)-(26) in error-state form, with Phi = G^-T Omega G^-1 and
@@ -122,7 +123,10 @@ void SeifSlam<Motion, Sensor>::augment(const NewLandmark& landmark) {
 template <class Motion, class Sensor>
 UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
   require_valid_observations(observations);
-  const auto [known, fresh] = split_known_and_new(pool_, observations);
+  auto [all_known, fresh] = split_known_and_new(pool_, observations);
+  UpdateResult result{0, fresh.size(), {}};
+  const auto known = gate(std::move(all_known), result.rejected);
+  result.corrected = known.size();
   // Linearize everything first; the rest runs as one transaction, undone if any step throws.
   std::vector<MeasurementInformation> measurements;
   measurements.reserve(known.size());
@@ -150,7 +154,40 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
     sparsify();
     require_factorizable_robot_and_active("SEIF update");
   });
-  return {known.size(), fresh.size(), {}};
+  return result;
+}
+
+/// The chi-square test of each known observation with S = H Sigma H^T + Q, Sigma the joint
+/// marginal of the robot and the landmark: one multi-column solve with the factor of Omega.
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::gate(std::vector<ObservationType> known, std::vector<LandmarkId>& rejected) const
+    -> std::vector<ObservationType> {
+  if (!gate_.on() || known.empty()) return known;
+  const Eigen::Index k = static_cast<Eigen::Index>(known.size());
+  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(state_dim(), X + M * k);
+  unit.topLeftCorner(X, X).setIdentity();
+  for (Eigen::Index i = 0; i < k; ++i)
+    unit.block(offset_of(pool_.slot(known[i].landmark_id)), X + M * i, M, M).setIdentity();
+  const Eigen::MatrixXd columns = factorization()->solve(unit);
+  std::vector<ObservationType> kept;
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const auto& observation = known[i];
+    const std::size_t slot = pool_.slot(observation.landmark_id);
+    const Linearized lin = linearize_observation(sensor_, x_, landmark_mean(slot), observation.z,
+                                                 observation.landmark_id, offset_of(slot));
+    const Eigen::Matrix<double, X, X> xx = columns.topLeftCorner(X, X);
+    const Eigen::Matrix<double, X, M> xm = columns.block(0, X + M * i, X, M);
+    const Eigen::Matrix<double, M, M> mm = columns.block(offset_of(slot), X + M * i, M, M);
+    const Eigen::Matrix<double, Z, Z> S =
+        symmetrized(lin.J_z_x * xx * lin.J_z_x.transpose() + lin.J_z_x * xm * lin.J_z_m.transpose() +
+                    lin.J_z_m * xm.transpose() * lin.J_z_x.transpose() + lin.J_z_m * mm * lin.J_z_m.transpose() + lin.Q);
+    const auto llt = cholesky_or_throw(S, "innovation covariance of landmark " + std::to_string(observation.landmark_id));
+    if (gate_.rejects(llt, lin.residual))
+      rejected.push_back(observation.landmark_id);
+    else
+      kept.push_back(observation);
+  }
+  return kept;
 }
 
 /// Runs `step` so that it either completes or, if it throws, leaves the filter exactly as before:
