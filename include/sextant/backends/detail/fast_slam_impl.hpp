@@ -198,7 +198,7 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
   UpdateResult result{0, fresh.size(), {}};
   const auto& best_rejected = rejected[best_particle(t.particles)];
   for (std::size_t i = 0; i < known.size(); ++i)
-    if (i < best_rejected.size() && best_rejected[i]) result.rejected.push_back(known[i].landmark_id);
+    if (best_rejected[i]) result.rejected.push_back(known[i].landmark_id);
   result.corrected = known.size() - result.rejected.size();
   normalize_and_resample(t);
   auto index = index_;
