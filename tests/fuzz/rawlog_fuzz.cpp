@@ -1,7 +1,7 @@
 // libFuzzer target: our code around MRPT's rawlog deserializer: reading the objects, telling a
 // planar from a spatial log, converting actions and observations into steps (read_rawlog).
 // MRPT's own deserializer is not instrumented; what it throws must come out as a sextant::error.
-#include "bounded_new.hpp"
+#include "../support/bounded_new.hpp"
 #include "fuzz_input_file.hpp"
 #include "sextant/core/error.hpp"
 #include "sextant/mrpt/rawlog.hpp"

@@ -24,7 +24,7 @@ Vector6d pose6(double x, double y, double z, double yaw, double pitch, double ro
 
 TEST(RangeBearing2D, JacobiansAndInverseModelMatchCentralDifferencesWithSensorOffset) {
   RangeBearing2D sensor;
-  for (const Eigen::Vector3d mount : {Eigen::Vector3d::Zero().eval(), Eigen::Vector3d(0.3, -0.2, 0.5)}) {
+  for (const Eigen::Vector3d& mount : {Eigen::Vector3d::Zero().eval(), Eigen::Vector3d(0.3, -0.2, 0.5)}) {
     sensor.sensor_pose = mount;
     for (double h : {-3.1, -1.0, 0.0, 0.7, 3.1}) {
       const auto check = testing::check_measurement_jacobians<Se2Odometry>(sensor, Eigen::Vector3d(1.0, 2.0, h),
@@ -88,7 +88,7 @@ TEST(Se3Odometry, PlanarMotionAgreesWithSe2Odometry) {
 
 TEST(RangeBearing3D, JacobiansAndInverseModelMatchCentralDifferences) {
   RangeBearing3D sensor;
-  for (const Vector6d mount : {Vector6d::Zero().eval(), pose6(0.5, 0.2, 0.1, 80.0 * kPi / 180, -20.0 * kPi / 180, 10.0 * kPi / 180)}) {
+  for (const Vector6d& mount : {Vector6d::Zero().eval(), pose6(0.5, 0.2, 0.1, 80.0 * kPi / 180, -20.0 * kPi / 180, 10.0 * kPi / 180)}) {
     sensor.sensor_pose = mount;
     for (double yaw : {-2.0, 0.0, 1.0}) {
       const auto check = testing::check_measurement_jacobians<Se3Odometry>(

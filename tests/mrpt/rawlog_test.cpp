@@ -4,11 +4,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CFileOutputStream.h>
 #include <numbers>
 
 #include "mrpt/mrpt_demo_data.hpp"
+#include "support/bounded_new.hpp"  // this binary's operator new throws above 1 GiB (see the corrupt-length test)
 #include "support/nees_bound.hpp"
 #include "support/temp_path.hpp"
 #ifdef SEXTANT_HAS_MRPT_SLAM
@@ -260,6 +262,30 @@ TEST_F(WrittenRawlog, BadLogsGiveOneLineErrorsNamingFileAndProblem) {
 
   for (const auto& path : {missing, empty, garbage, truncated, no_id, nan, pitched})
     EXPECT_EQ(error_of(path).find('\n'), std::string::npos) << path;
+}
+
+// Fuzz finding 3 (docs/reliability.md): a corrupt length field makes MRPT's deserializer ask for
+// tens of gigabytes. This binary's operator new throws std::bad_alloc above 1 GiB
+// (support/bounded_new.hpp), as new does on a machine without that memory, so the test never asks
+// the system for it; the reader must turn it into a one-line parse_error.
+TEST_F(WrittenRawlog, CorruptLengthFieldIsAMalformedLogNotACrash) {
+  constexpr std::uint32_t kCount = 2827;  // measurements: a length field that occurs nowhere else in the log
+  std::vector<std::pair<int, float>> many;
+  for (std::uint32_t i = 0; i < kCount; ++i) many.push_back({static_cast<int>(i), 2.0f});  // ids below kCount
+  const auto path = write("long.rawlog", true, action(0.5, 0.0, 0.1), frame(bearing(many)));
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string field(reinterpret_cast<const char*>(&kCount), sizeof kCount);
+  const auto at = bytes.find(field);
+  ASSERT_NE(at, std::string::npos) << "the measurement count is not in the log";
+  ASSERT_EQ(bytes.find(field, at + 1), std::string::npos) << "the measurement count occurs twice";
+  constexpr std::uint32_t kHuge = 0x7fffffff;
+  bytes.replace(at, sizeof kHuge, reinterpret_cast<const char*>(&kHuge), sizeof kHuge);
+  const auto corrupt = (dir / "corrupt.rawlog").string();
+  std::ofstream(corrupt, std::ios::binary) << bytes;
+  const auto message = error_of(corrupt);
+  EXPECT_NE(message.find(corrupt + ": entry 1: truncated or malformed"), std::string::npos) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos);
 }
 
 TEST_F(WrittenRawlog, GroundTruthMustCoverEveryStepAndLandmark) {
