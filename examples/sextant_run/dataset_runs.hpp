@@ -22,5 +22,8 @@ std::vector<TableRow> run_globe(const RunOptions& options, const std::vector<Bac
 /// One or all robots of a UTIAS MRCLAM data set, spec "<directory>:<robot 1-5 | all>" (run_mrclam.cpp).
 std::vector<TableRow> run_mrclam(const RunOptions& options, const std::string& spec, const std::vector<BackendKind>& kinds,
                                  const RunnerConfig& config);
+/// A planar data set in the iSAM/GTSAM text format, scored if its ground truth lies beside it (run_isam.cpp).
+std::vector<TableRow> run_isam(const RunOptions& options, const std::string& path, const std::vector<BackendKind>& kinds,
+                               const RunnerConfig& config);
 
 }  // namespace sextant::runner

@@ -5,6 +5,7 @@
 #include <optional>
 #include <sextant/eval/experiment.hpp>
 #include <sextant/eval/monte_carlo.hpp>
+#include <sextant/eval/withheld_ids.hpp>
 #include <string>
 #include <vector>
 
@@ -22,7 +23,23 @@ struct BackendRun {
   eval::RunSummary<State> run;
   std::vector<LandmarkEstimate<M>> map;
   std::vector<State> particles;  ///< FastSLAM's particle poses after the last step
+  std::optional<eval::AssociationScore> association;  ///< when the ids were withheld
 };
+
+/// Whether a back-end can run with its ids withheld (it hands data association its joint marginal).
+inline bool associates(BackendKind kind) { return kind == BackendKind::ekf || kind == BackendKind::seif; }
+
+inline AssociationRow association_row(const eval::AssociationScore& a) {
+  return {a.precision(), a.recall(), a.wrong(), a.duplicates(), a.discarded()};
+}
+
+/// Whether `kind` sits this data set out because the ids are withheld and it cannot associate.
+inline bool left_out(BackendKind kind, const RunnerConfig& c, const std::string& dataset) {
+  if (!c.association.method || associates(kind)) return false;
+  std::printf("%s: %s needs known ids, left out (--associate is for EKF and SEIF)\n", dataset.c_str(),
+              backend_key(kind).c_str());
+  return true;
+}
 
 /// Runs one back-end over the data set; on_step(k) after every step.
 template <class Dataset, class OnStep>
@@ -37,20 +54,38 @@ BackendRun<Dataset> run_backend(BackendKind kind, const Dataset& data, const Run
     if constexpr (requires { backend.particles(); })
       for (const auto& particle : backend.particles()) out.particles.push_back(particle.x);
   };
+  /// Scored against the ground truth, or only recorded when the data set has none.
+  const auto evaluate = [&](auto& backend) {
+    if constexpr (requires { data.has_ground_truth(); })
+      if (!data.has_ground_truth()) return eval::record_unscored_run(backend, data, on_step);
+    if constexpr (requires { backend.optimize(); })
+      return eval::evaluate_smoothed_run(backend, data, scoring.position_dim, on_step);
+    else
+      return eval::evaluate_run(backend, data, scoring.position_dim, on_step);
+  };
+  /// A filter run with the data set's ids, or with them withheld and associated.
+  const auto run_filter = [&](auto& backend) {
+    if (!c.association.method) return finish(backend, evaluate(backend));
+    AssociationOptions options = c.association.options;
+    options.method = *c.association.method;
+    eval::WithheldIds withheld(backend, data.sensor, options);
+    finish(withheld, evaluate(withheld));
+    out.association = withheld.score();
+  };
   switch (kind) {
     case BackendKind::ekf: {
       EkfSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, c.ekf);
-      finish(b, eval::evaluate_run(b, data, scoring.position_dim, on_step));
+      run_filter(b);
       break;
     }
     case BackendKind::seif: {
       SeifSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, c.seif);
-      finish(b, eval::evaluate_run(b, data, scoring.position_dim, on_step));
+      run_filter(b);
       break;
     }
     case BackendKind::graph: {
       GraphSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, c.graph);
-      finish(b, eval::evaluate_smoothed_run(b, data, scoring.position_dim, on_step));
+      finish(b, evaluate(b));
       break;
     }
     case BackendKind::fastslam1:
@@ -58,7 +93,7 @@ BackendRun<Dataset> run_backend(BackendKind kind, const Dataset& data, const Run
       FastSlamOptions o = c.fastslam;
       o.version = kind == BackendKind::fastslam1 ? FastSlamVersion::v1 : FastSlamVersion::v2;
       FastSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, o);
-      finish(b, eval::evaluate_run(b, data, scoring.position_dim, on_step));
+      finish(b, evaluate(b));
       break;
     }
   }
@@ -72,10 +107,14 @@ std::vector<TableRow> run_on_rawlog(const std::string& name, const Dataset& data
                                     std::vector<std::pair<BackendKind, BackendRun<Dataset>>>& first_runs) {
   std::vector<TableRow> rows;
   for (BackendKind kind : kinds) {
+    if (left_out(kind, c, name)) continue;
     ProgressBar progress(name + ": " + backend_key(kind), data.steps.size());
     auto result = run_backend(kind, data, c, scoring, [&](std::size_t) { progress.advance(); });
     rows.push_back({name, backend_key(kind), backend_label(kind, c),
-                    eval::summarize(std::vector{result.run}, scoring.pose_dof, scoring.landmark_dof), 1});
+                    eval::summarize(std::vector{result.run}, scoring.pose_dof, scoring.landmark_dof), 1, std::nullopt});
+    if (const auto& a = result.association) rows.back().association = association_row(*a);
+    if constexpr (requires { data.has_ground_truth(); })
+      if (!data.has_ground_truth()) rows.back().summary.mark_unscored();
     first_runs.emplace_back(kind, std::move(result));
   }
   return rows;
@@ -88,6 +127,7 @@ std::vector<TableRow> run_on_ship(const std::vector<BackendKind>& kinds, const R
                                   std::vector<std::pair<BackendKind, BackendRun<Dataset>>>& first_runs) {
   std::vector<TableRow> rows;
   for (BackendKind kind : kinds) {
+    if (left_out(kind, c, "ship")) continue;
     ProgressBar progress("ship: " + backend_key(kind), static_cast<std::size_t>(c.ship_runs));
     std::optional<BackendRun<Dataset>> first;
     std::mutex first_mutex;
@@ -103,7 +143,9 @@ std::vector<TableRow> run_on_ship(const std::vector<BackendKind>& kinds, const R
       return result.run;
     });
     rows.push_back({"ship", backend_key(kind), backend_label(kind, c),
-                    eval::summarize(runs, scoring.pose_dof, scoring.landmark_dof), c.ship_runs});
+                    eval::summarize(runs, scoring.pose_dof, scoring.landmark_dof), c.ship_runs, std::nullopt});
+    if (const auto& a = first->association)  // the first seed's
+      rows.back().association = association_row(*a);
     first_runs.emplace_back(kind, std::move(*first));
   }
   return rows;

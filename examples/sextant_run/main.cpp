@@ -24,6 +24,12 @@ const char* const kMrptDatasets = "/usr/share/mrpt/datasets";
 const std::vector<std::string> kMrptDemos = {"kf-slam_demo.rawlog", "kf-slam_6D_demo.rawlog",
                                              "kf-slam_6D_demo_noncentered.rawlog"};
 
+/// A data set in the iSAM/GTSAM text format: named .txt or .graph (rawlogs are binary).
+bool is_isam_text(const std::string& path) {
+  const auto extension = std::filesystem::path(path).extension();
+  return extension == ".txt" || extension == ".graph";
+}
+
 /// "ship", "mrpt-demos" (the installed demo rawlogs) or a rawlog path, expanded.
 std::vector<std::string> expand_datasets(const std::vector<std::string>& requested) {
   std::vector<std::string> out;
@@ -95,6 +101,7 @@ int main(int argc, char** argv) {
                        for (const auto& dataset : expand_datasets(options.datasets)) {
                          auto part = dataset == "ship"                ? run_ship(options.output, kinds, config)
                                      : dataset.rfind("mrclam:", 0) == 0 ? run_mrclam(options.output, dataset.substr(7), kinds, config)
+                                     : is_isam_text(dataset)            ? run_isam(options.output, dataset, kinds, config)
                                                                         : run_rawlog(options, dataset, kinds, config);
                          rows.insert(rows.end(), part.begin(), part.end());
                        }

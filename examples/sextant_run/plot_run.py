@@ -55,8 +55,10 @@ def plot_map(directory, key, steps, landmarks, truth, unit):
         ax.plot([p[0] for p in truth], [p[1] for p in truth], color="black", linewidth=1.0, label="true trajectory")
     ax.plot([s["x"] for s in steps], [s["y"] for s in steps], color="tab:red", linewidth=1.0,
             label="estimated trajectory")
-    ax.scatter([l["true_x"] for l in landmarks], [l["true_y"] for l in landmarks], marker="+", color="tab:green",
-               s=40, label="true landmarks", zorder=3)
+    known = [l for l in landmarks if math.isfinite(l["true_x"])]  # none without ground truth
+    if known:
+        ax.scatter([l["true_x"] for l in known], [l["true_y"] for l in known], marker="+", color="tab:green",
+                   s=40, label="true landmarks", zorder=3)
     ax.scatter([l["x"] for l in landmarks], [l["y"] for l in landmarks], marker=".", color="tab:blue", s=20,
                label="estimated landmarks (95% ellipses)", zorder=3)
     for l in landmarks:

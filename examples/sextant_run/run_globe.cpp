@@ -169,7 +169,7 @@ TableRow table_row(const GlobeRun& r, std::size_t steps) {
   s.pose_anees = r.summary.position_anees;
   s.total_seconds = r.total_seconds;
   s.seconds_per_step = r.total_seconds / static_cast<double>(steps);
-  return {"globe", r.key, r.label, s, 1};
+  return {"globe", r.key, r.label, s, 1, std::nullopt};
 }
 
 void write_globe_outputs(const RunOptions& options, const Dataset& data, const std::vector<GlobeRun>& runs,

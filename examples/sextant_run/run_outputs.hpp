@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 #include <sextant/core/pose3_euler_space.hpp>
 #include <sextant/eval/metrics.hpp>
@@ -38,9 +39,12 @@ void write_steps_csv(const std::string& path, const BackendRun<Dataset>& r, cons
   std::vector<std::string> header{"step", "x", "y", "z", "pose_error", "pose_nees", "nees_bound_95", "seconds"};
   io::CsvWriter csv(path, header);
   const double bound = eval::nees_upper_bound(scoring.pose_dof, 0.95);
+  const auto at = [](const std::vector<double>& v, std::size_t k) {  // NaN where unscored (no ground truth)
+    return k < v.size() ? v[k] : std::numeric_limits<double>::quiet_NaN();
+  };
   for (std::size_t k = 0; k < r.run.trajectory.size(); ++k) {
     const Eigen::Vector3d p = position_3d(r.run.trajectory[k]);
-    csv.row({static_cast<double>(k + 1), p.x(), p.y(), p.z(), r.run.pose_error[k], r.run.pose_nees[k], bound,
+    csv.row({static_cast<double>(k + 1), p.x(), p.y(), p.z(), at(r.run.pose_error, k), at(r.run.pose_nees, k), bound,
              k < r.run.seconds.size() ? r.run.seconds[k] : 0.0});
   }
 }
@@ -49,10 +53,14 @@ template <class Dataset>
 void write_map_csv(const std::string& path, const BackendRun<Dataset>& r, const Dataset& data) {
   io::CsvWriter csv(path, {"id", "x", "y", "z", "true_x", "true_y", "true_z", "cov_xx", "cov_xy", "cov_yy"});
   for (const auto& l : r.map) {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero(), truth = Eigen::Vector3d::Zero();
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    Eigen::Vector3d truth = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());  // none known
     mean.head(l.mean.size()) = l.mean;
     const auto it = data.true_landmarks.find(l.id);
-    if (it != data.true_landmarks.end()) truth.head(it->second.size()) = it->second;
+    if (it != data.true_landmarks.end()) {
+      truth.setZero();
+      truth.head(it->second.size()) = it->second;
+    }
     csv.row({static_cast<double>(l.id), mean.x(), mean.y(), mean.z(), truth.x(), truth.y(), truth.z(), l.cov(0, 0),
              l.cov(0, 1), l.cov(1, 1)});
   }

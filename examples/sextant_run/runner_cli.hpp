@@ -19,6 +19,7 @@ struct CliOptions {
   std::vector<std::string> datasets;
   std::string config;
   int runs = 0;
+  std::string associate;  ///< overrides [association] method when set
   bool print_config = false;
   RunOptions output;
 };
@@ -29,11 +30,15 @@ inline void add_runner_options(CLI::App& app, CliOptions& options) {
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--dataset,-d", options.datasets,
-                 "ship | globe | mrpt-demos | <file.rawlog> | mrclam:<dir>:<robot 1-5|all> (repeatable; default: ship and the "
+                 "ship | globe | mrpt-demos | <file.rawlog> | <file.txt> (iSAM/GTSAM planar text) | mrclam:<dir>:<robot 1-5|all> "
+                 "(repeatable; default: ship and the "
                  "MRPT kf-slam demos)");
   app.add_option("--config,-c", options.config, "ini file (MRPT CConfigFile) with [ship] [globe] [rawlog] [ekf] [seif] [graph] "
                                                 "[fastslam] [scene] keys; see --print-config");
   app.add_option("--out,-o", options.output.out, "directory for per-step CSV, TUM, .3Dscene files and summary.json");
+  app.add_option("--associate", options.associate,
+                 "known|nn|jcbb: use the data set's landmark ids, or withhold them and associate by nearest neighbour "
+                 "or JCBB (EKF and SEIF; overrides [association] method)");
   app.add_option("--runs", options.runs, "Monte Carlo runs on the ship (overrides [ship] runs)")->check(CLI::Range(1, 100000));
   app.add_flag("--plots", options.output.plots, "also write PNG plots of trajectory, map, error and NEES (needs --out or "
                                                 "writes to ./sextant-run-output)");
@@ -57,6 +62,15 @@ inline std::vector<BackendKind> parse_backends(const std::vector<std::string>& n
 inline RunnerConfig load_runner_config(CliOptions& options) {
   RunnerConfig config = load_config(options.config);
   if (options.runs > 0) config.ship_runs = options.runs;
+  if (!options.associate.empty()) {
+    const auto key = std::find_if(config_keys().begin(), config_keys().end(),
+                                  [](const ConfigKey& k) { return k.section == "association" && k.key == "method"; });
+    try {
+      key->apply(config, options.associate);
+    } catch (const invalid_input_error& e) {
+      throw invalid_input_error(std::string("--associate: ") + e.what());
+    }
+  }
   if (options.output.plots && options.output.out.empty()) options.output.out = "sextant-run-output";
   return config;
 }

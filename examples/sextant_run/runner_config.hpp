@@ -17,6 +17,7 @@
 #include <sextant/backends/fast_slam.hpp>
 #include <sextant/backends/graph_slam.hpp>
 #include <sextant/backends/seif_slam.hpp>
+#include <sextant/core/data_association.hpp>
 #include <sextant/core/error.hpp>
 #include <sextant/io/mrclam_reader.hpp>
 #include <sextant/io/parse_number.hpp>
@@ -43,6 +44,12 @@ struct GlobeSettings {
   int graph_updates = 10;              ///< GraphSLAM global updates after the windowed initialization
 };
 
+/// Measurement ids withheld and found again by data association (EKF and SEIF), or used as given.
+struct AssociationSettings {
+  std::optional<AssociationMethod> method;  ///< none: the data set's ids are used
+  AssociationOptions options;
+};
+
 struct RunnerConfig {
   sim::Ship2DOptions ship;
   int ship_runs = 10;
@@ -53,6 +60,7 @@ struct RunnerConfig {
   FastSlamOptions fastslam{.particles = 100, .resample_threshold = 0.1, .map_estimate = FastSlamMap::weighted_average};
   GlobeSettings globe;
   io::MrclamOptions mrclam;
+  AssociationSettings association;
   double scene_quantile = 3.0;
 };
 
@@ -188,6 +196,12 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.rawlog.max_steps = parse_integer<std::size_t>(v, 0); }},
       {"mrclam", "max_step", "0.25", "MRCLAM: longest step without a measurement, s (steps also end at every measurement)",
        [](RunnerConfig& c, const std::string& v) { c.mrclam.max_step = positive(parse_number(v), v); }},
+      {"mrclam", "odometry_delay", "0.2", "MRCLAM: seconds added to the odometry time stamps (Dataset6: 0.2 matches Vicon best)",
+       [](RunnerConfig& c, const std::string& v) {
+         const double d = parse_number(v);
+         if (!(std::abs(d) <= 10.0)) throw invalid_input_error("'" + v + "' must be in [-10, 10] s");
+         c.mrclam.odometry_delay = d;
+       }},
       {"mrclam", "std_range", "0.15", "MRCLAM: range noise, m (robust SD against Vicon: 0.13)",
        [](RunnerConfig& c, const std::string& v) { c.mrclam.measurement_sigma(0) = positive(parse_number(v), v); }},
       {"mrclam", "std_bearing_deg", "1.146", "MRCLAM: bearing noise, degrees (robust SD against Vicon: 0.49)",
@@ -202,6 +216,29 @@ inline const std::vector<ConfigKey>& config_keys() {
          if (values.size() != 6 || std::any_of(values.begin(), values.end(), [](double a) { return a < 0.0; }))
            throw invalid_input_error("'" + v + "' must be six non-negative numbers");
          std::copy(values.begin(), values.end(), c.mrclam.motion.alpha.begin());
+       }},
+      {"association", "method", "known",
+       "known (the data set's ids) | nn (nearest neighbour) | jcbb (joint compatibility): ids withheld and found by "
+       "EKF and SEIF; the other back-ends need known ids",
+       [](RunnerConfig& c, const std::string& v) {
+         c.association.method = parse_choice<std::optional<AssociationMethod>>(
+             v, {{"known", std::nullopt},
+                 {"nn", AssociationMethod::nearest_neighbour},
+                 {"jcbb", AssociationMethod::joint_compatibility}});
+       }},
+      {"association", "gate_probability", "0.99", "chi-square gate of individual and joint compatibility",
+       [](RunnerConfig& c, const std::string& v) {
+         const double p = parse_number(v);
+         if (!(p > 0.0 && p < 1.0)) throw invalid_input_error("'" + v + "' must be in (0, 1)");
+         c.association.options.gate_probability = p;
+       }},
+      {"association", "new_landmark_probability", "0.9999",
+       "a measurement outside every landmark's gate at this probability starts a new landmark; inside one but unpaired "
+       "it is discarded",
+       [](RunnerConfig& c, const std::string& v) {
+         const double p = parse_number(v);
+         if (!(p > 0.0 && p < 1.0)) throw invalid_input_error("'" + v + "' must be in (0, 1)");
+         c.association.options.new_landmark_probability = p;
        }},
       {"ekf", "batch_update", "true", "one joint correction per step (true) or one per observation (false)",
        [](RunnerConfig& c, const std::string& v) { c.ekf.batch_update = parse_bool(v); }},

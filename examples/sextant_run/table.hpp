@@ -1,10 +1,12 @@
 #pragma once
 // The comparison table's rows: which back-end, with what settings, and its scores; printing them and
 // writing them as JSON. Light: no back-end is instantiated here.
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <limits>
+#include <optional>
 #include <sextant/eval/experiment.hpp>
 #include <sstream>
 #include <string>
@@ -52,11 +54,18 @@ struct Scoring {
   int position_dim, pose_dof, landmark_dof;
 };
 
+/// How a run with withheld ids associated its measurements (eval::AssociationScore).
+struct AssociationRow {
+  double precision, recall;
+  std::size_t wrong, duplicates, discarded;
+};
+
 /// A line of the comparison table.
 struct TableRow {
   std::string dataset, backend, label;
   eval::Summary summary;
   int runs = 1;
+  std::optional<AssociationRow> association;
 };
 
 /// The table's header line; the README's results table must show the same (tests/mrpt/runner_cli_test).
@@ -65,11 +74,23 @@ inline void print_header() {
               "aligned", "pose NEES in", "map NEES in", "pose ANEES", "total [s]", "per step[us]");
 }
 
+/// A score as the table prints it: "-" when there is none (no ground truth).
+inline std::string cell(const char* format, double value) {
+  if (std::isnan(value)) return "-";
+  char text[32];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
 inline void print_row(const TableRow& row) {
   const auto& s = row.summary;
-  std::printf("%-29s %10.4g %10.4g %10.4g %10.4g %12.1f%% %11.1f%% %11.4g %10.4f %13.1f\n", row.label.c_str(), s.pose_mae,
-              s.pose_mae_aligned, s.map_mae, s.map_mae_aligned, 100.0 * s.pose_nees_inside, 100.0 * s.map_nees_inside,
-              s.pose_anees, s.total_seconds, 1e6 * s.seconds_per_step);
+  std::printf("%-29s %10s %10s %10s %10s %13s %12s %11s %10.4f %13.1f\n", row.label.c_str(), cell("%.4g", s.pose_mae).c_str(),
+              cell("%.4g", s.pose_mae_aligned).c_str(), cell("%.4g", s.map_mae).c_str(), cell("%.4g", s.map_mae_aligned).c_str(),
+              cell("%.1f%%", 100.0 * s.pose_nees_inside).c_str(), cell("%.1f%%", 100.0 * s.map_nees_inside).c_str(),
+              cell("%.4g", s.pose_anees).c_str(), s.total_seconds, 1e6 * s.seconds_per_step);
+  if (const auto& a = row.association)
+    std::printf("%-29s association: precision %.4f, recall %.4f; %zu wrong pairings, %zu duplicate landmarks, %zu "
+                "discarded\n", "", a->precision, a->recall, a->wrong, a->duplicates, a->discarded);
 }
 
 inline std::string json_number(double x) {
@@ -92,7 +113,11 @@ inline void write_summary_json(const std::string& path, const std::vector<TableR
         << ", \"map_mae_aligned\": " << json_number(s.map_mae_aligned) << ", \"pose_nees_inside\": " << json_number(s.pose_nees_inside)
         << ", \"map_nees_inside\": " << json_number(s.map_nees_inside) << ", \"pose_anees\": " << json_number(s.pose_anees)
         << ", \"total_seconds\": " << json_number(s.total_seconds)
-        << ", \"seconds_per_step\": " << json_number(s.seconds_per_step) << "}" << (i + 1 < rows.size() ? ",\n" : "\n");
+        << ", \"seconds_per_step\": " << json_number(s.seconds_per_step);
+    if (const auto& a = rows[i].association)
+      out << ", \"association_precision\": " << json_number(a->precision)
+          << ", \"association_recall\": " << json_number(a->recall);
+    out << "}" << (i + 1 < rows.size() ? ",\n" : "\n");
   }
   out << "]\n";
 }

@@ -1,4 +1,5 @@
 #include "sextant/io/isam_reader.hpp"
+#include "sextant/io/isam_dataset.hpp"
 
 #include <gtest/gtest.h>
 
@@ -111,6 +112,58 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(IsamReader, MissingOrEmptyFile) {
   EXPECT_THROW(read_isam_2d("/nonexistent/file.txt", IsamNoise::covariance), parse_error);
   EXPECT_THROW(read_isam_2d(write_file("empty", "# nothing\n"), IsamNoise::covariance), parse_error);
+}
+
+/// A directory of its own, removed at the end of the test, for files whose names must match.
+struct TempDirectory {
+  std::filesystem::path path = test::unique_temp_path("isam_dataset");
+  TempDirectory() { std::filesystem::create_directories(path); }
+  ~TempDirectory() { std::filesystem::remove_all(path); }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream((path / name).string()) << text;
+    return (path / name).string();
+  }
+};
+
+TEST(IsamDataset, SightingsBeforeTheFirstOdometryComeInAStillStepAndTheCompanionIsTheTruth) {
+  const TempDirectory dir;
+  const auto path = dir.write("trees.txt", "LANDMARK 0 3 1 0.1 10 0 10\n"
+                                           "EDGE2 0 1 1 0 0 50 0 0 50 0 100\n"
+                                           "LANDMARK 1 3 0.1 0 10 0 10\n");
+  EXPECT_FALSE(read_isam_dataset(path).has_ground_truth()) << "no companion yet";
+  dir.write("trees_groundtruth.txt", "LANDMARK 0 3 1 0 10 0 10\n"
+                                     "EDGE2 0 1 1 0 0 50 0 0 50 0 100\n"
+                                     "LANDMARK 1 3 0 0 10 0 10\n");
+  EXPECT_EQ(detect_isam_noise(path), IsamNoise::square_root_information);
+  const auto data = read_isam_dataset(path);
+  ASSERT_EQ(data.steps.size(), 2u);
+  EXPECT_EQ(data.steps[0].control.delta, Eigen::Vector3d::Zero()) << "the still step";
+  ASSERT_EQ(data.steps[0].observations.size(), 1u);
+  EXPECT_EQ(data.steps[0].observations[0].landmark_id, 3u);
+  EXPECT_TRUE(data.steps[1].control.delta.isApprox(Eigen::Vector3d(1, 0, 0)));
+  EXPECT_TRUE(data.sensor.Q.isApprox(0.01 * Eigen::Matrix2d::Identity())) << "sqrt information 10 is variance 0.01";
+  ASSERT_TRUE(data.has_ground_truth());
+  ASSERT_EQ(data.true_poses.size(), 3u) << "one pose per step and the start";
+  EXPECT_EQ(data.true_poses[1], data.true_poses[0]);
+  EXPECT_TRUE(data.true_poses[2].isApprox(Eigen::Vector3d(1, 0, 0)));
+  EXPECT_TRUE(data.true_landmarks.at(3).isApprox(Eigen::Vector2d(1, 0)));
+}
+
+TEST(IsamDataset, NoiseFormIsReadOffTheRecordsAndAMismatchedCompanionIsAnError) {
+  const TempDirectory dir;
+  const auto gtsam = dir.write("park.txt", "ODOMETRY 0 1 1 0 0 0.01 0 0 0.01 0 0.001\nLANDMARK 1 4 2 1 0.1 0 0.1\n");
+  EXPECT_EQ(detect_isam_noise(gtsam), IsamNoise::covariance);
+  EXPECT_TRUE(read_isam_dataset(gtsam).sensor.Q.isApprox(0.1 * Eigen::Matrix2d::Identity()));
+  const auto path = dir.write("run.txt", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\n");
+  const auto companion = dir.write("run_groundtruth.txt", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 1 2 1 0 0 50 0 0 50 0 100\n");
+  try {
+    read_isam_dataset(path);
+    FAIL() << "a companion with more odometry was accepted";
+  } catch (const parse_error& e) {
+    EXPECT_NE(std::string(e.what()).find(companion + ": 2 odometry records, but"), std::string::npos) << e.what();
+  }
+  const auto landmarks_only = dir.write("empty.txt", "# nothing\n");
+  EXPECT_THROW(detect_isam_noise(landmarks_only), parse_error);
 }
 
 }  // namespace

@@ -270,4 +270,35 @@ TEST_F(RunnerCli, IniValuesReachTheBackEnds) {
   EXPECT_NE(r.out.find("FastSLAM 1.0, 7 particles"), std::string::npos) << r.out;
 }
 
+TEST_F(RunnerCli, WithheldIdsAreAssociatedAndScoredByTheFiltersOnly) {
+  const auto r = run_runner("-d ship --runs 1 -b ekf,graph --associate jcbb", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("ship: graph needs known ids, left out"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("EKF-SLAM"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("association: precision"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("GraphSLAM "), std::string::npos) << r.out;
+  const auto bad = run_runner("-d ship --runs 1 -b ekf --associate magic", dir);
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("--associate: 'magic' is not one of known|nn|jcbb"), std::string::npos) << bad.err;
+}
+
+TEST_F(RunnerCli, IsamTextWithoutGroundTruthIsTimedAndWrittenNotScored) {
+  const auto data = (dir / "loop.txt").string();
+  std::ofstream file(data);
+  file << "LANDMARK 0 1 2 1 10 0 10\n";
+  for (int k = 0; k < 8; ++k)  // a square, the landmark seen from every pose
+    file << "EDGE2 " << k << " " << k + 1 << " 1 0 1.5707963 50 0 0 50 0 100\nLANDMARK " << k + 1 << " 1 1 1 10 0 10\n";
+  file.close();
+  const auto out = dir / "isam_out";
+  const auto r = run_runner("-d " + data + " -b ekf,graph -o " + out.string(), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("no ground truth beside it"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("EKF-SLAM                               -          -"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(out / "loop" / "graph_map.csv"));
+  std::ifstream json((out / "summary.json").string());
+  std::stringstream text;
+  text << json.rdbuf();
+  EXPECT_NE(text.str().find("\"pose_mae\": null"), std::string::npos) << text.str();
+}
+
 }  // namespace

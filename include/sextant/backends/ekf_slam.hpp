@@ -10,6 +10,7 @@
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/innovation_gate.hpp"
+#include "sextant/core/joint_marginal.hpp"
 #include "sextant/core/landmark_pool.hpp"
 #include "sextant/core/linearized_observation.hpp"
 #include "sextant/core/symmetric_matrix.hpp"
@@ -81,6 +82,9 @@ class EkfSlam {
   PoseEstimate pose() const { return {x_, symmetric_diagonal_block<X>(cov_.view(), 0)}; }
   LandmarkEstimate<M> landmark(LandmarkId id) const { return landmark_at(pool_.slot(id)); }
   MapEstimate map() const;
+  /// The joint Gaussian of the robot and the landmarks `ids`, in that order (for data association,
+  /// core/data_association.hpp): a gather from P, O((X + M k)^2). Throws unknown_landmark_error.
+  JointMarginal<State, M> joint_marginal(std::span<const LandmarkId> ids) const;
   bool has_landmark(LandmarkId id) const { return pool_.contains(id); }
   std::size_t num_landmarks() const { return pool_.size(); }
   /// Joint covariance of (robot, landmarks in slot order), dimension X + M * num_landmarks().

@@ -14,6 +14,7 @@
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/innovation_gate.hpp"
+#include "sextant/core/joint_marginal.hpp"
 #include "sextant/core/landmark_pool.hpp"
 #include "sextant/core/linearized_observation.hpp"
 #include "sextant/core/sparse_cholesky.hpp"
@@ -96,6 +97,10 @@ class SeifSlam {
   const State& pose_mean() const { return x_; }
   LandmarkEstimate<M> landmark(LandmarkId id) const;
   MapEstimate map() const;
+  /// The joint Gaussian of the robot and the landmarks `ids`, in that order (for data association,
+  /// core/data_association.hpp): one multi-column solve with the factor of Omega, X + M k columns.
+  /// Throws unknown_landmark_error.
+  JointMarginal<State, M> joint_marginal(std::span<const LandmarkId> ids) const;
   bool has_landmark(LandmarkId id) const { return pool_.contains(id); }
   std::size_t num_landmarks() const { return pool_.size(); }
   const std::vector<LandmarkId>& landmark_ids() const { return pool_.ids(); }
@@ -132,8 +137,9 @@ class SeifSlam {
   static Eigen::Index offset_of(std::size_t slot) { return X + M * static_cast<Eigen::Index>(slot); }
   Landmark landmark_mean(std::size_t slot) const { return landmark_means_.template segment<M>(M * slot); }
 
-  MeasurementInformation measurement_information(const ObservationType& observation) const;
-  std::vector<ObservationType> gate(std::vector<ObservationType> known, std::vector<LandmarkId>& rejected) const;
+  Linearized linearize(const ObservationType& observation) const;
+  MeasurementInformation measurement_information(const Linearized& lin) const;
+  void gate(std::vector<Linearized>& observations, std::vector<LandmarkId>& rejected) const;
   NewLandmark new_landmark(const ObservationType& observation) const;
   void add(const MeasurementInformation& info);
   void augment(const NewLandmark& landmark);
@@ -160,6 +166,8 @@ class SeifSlam {
   void sparsify();
   std::shared_ptr<const Factor> factorization() const;
   Eigen::MatrixXd marginal_covariance(Eigen::Index offset, Eigen::Index size) const;
+  /// The joint covariance of the robot and the landmark blocks starting at `offsets`, in that order.
+  Eigen::MatrixXd joint_covariance(const std::vector<Eigen::Index>& offsets) const;
   void touch() { ++revision_; }
 
   Motion motion_;

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -69,6 +70,28 @@ void add_aligned_errors(Summary& out, const Map& map, const Dataset& dataset, in
   }
   out.map_error_aligned = aligned_position_errors(estimated, true_points, static_cast<int>(Point::RowsAtCompileTime));
 }
+/// predict + update over every step of the data set, each timed into out.seconds and
+/// out.total_seconds; after(k) once step k is done.
+template <class Backend, class Dataset, class Summary, class After>
+void run_timed_steps(Backend& backend, const Dataset& dataset, Summary& out, After after) {
+  using Clock = std::chrono::steady_clock;
+  for (const auto& step : dataset.steps) {
+    const auto start = Clock::now();
+    backend.predict(step.control, step.dt);
+    backend.update(step.observations);
+    out.seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    out.total_seconds += out.seconds.back();
+    after(out.seconds.size() - 1);
+  }
+}
+
+/// Full SLAM's optimize(), its time added to out.total_seconds.
+template <class Backend, class Summary>
+void optimize_timed(Backend& backend, Summary& out) {
+  const auto start = std::chrono::steady_clock::now();
+  backend.optimize();
+  out.total_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 }  // namespace detail
 
 /// Runs `backend` over dataset.steps and scores it against dataset.true_poses (row k + 1 is the
@@ -116,19 +139,9 @@ template <class Backend, class Dataset, class OnStep = NoStepCallback>
 RunSummary<typename Backend::State> evaluate_smoothed_run(Backend& backend, const Dataset& dataset, int position_dim = -1,
                                                           OnStep on_step = {}) {
   using Space = typename Backend::Space;
-  using Clock = std::chrono::steady_clock;
   RunSummary<typename Backend::State> out;
-  for (const auto& step : dataset.steps) {
-    const auto start = Clock::now();
-    backend.predict(step.control, step.dt);
-    backend.update(step.observations);
-    out.seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-    out.total_seconds += out.seconds.back();
-    on_step(out.seconds.size() - 1);
-  }
-  const auto start = Clock::now();
-  backend.optimize();
-  out.total_seconds += std::chrono::duration<double>(Clock::now() - start).count();
+  detail::run_timed_steps(backend, dataset, out, on_step);
+  detail::optimize_timed(backend, out);
   const auto trajectory = backend.trajectory();
   for (std::size_t k = 1; k < trajectory.size(); ++k) {
     const auto error = Space::minus(trajectory[k].mean, dataset.true_poses[k]);
@@ -159,6 +172,14 @@ struct Summary {
   std::optional<Interval> anees_interval;
   double pose_mae_std = 0.0;  ///< standard deviation of the per-run pose MAE
   double map_mae_std = 0.0;
+
+  /// Marks every score NaN (a run without ground truth has only its time).
+  void mark_unscored() {
+    constexpr double none = std::numeric_limits<double>::quiet_NaN();
+    pose_mae = map_mae = map_mae_over_time = pose_rmse = pose_mae_aligned = map_mae_aligned = none;
+    pose_nees_inside = map_nees_inside = pose_anees = pose_mae_std = map_mae_std = none;
+    anees_interval.reset();
+  }
 };
 
 template <class State>
@@ -194,6 +215,24 @@ Summary summarize(const std::vector<RunSummary<State>>& runs, int pose_dof, int 
   if (runs.size() > 1 && std::isfinite(s.pose_anees))
     s.anees_interval = time_averaged_anees_interval(pose_dof, nees_averages, confidence);
   return s;
+}
+
+/// A run without ground truth (e.g. Victoria Park): the trajectory and the time of every step and
+/// nothing scored. Full SLAM (optimize() and trajectory()) is optimized once at the end and gives
+/// its smoothed trajectory; a filter its pose after each step.
+template <class Backend, class Dataset, class OnStep = NoStepCallback>
+RunSummary<typename Backend::State> record_unscored_run(Backend& backend, const Dataset& dataset, OnStep on_step = {}) {
+  RunSummary<typename Backend::State> out;
+  detail::run_timed_steps(backend, dataset, out, [&](std::size_t k) {
+    if constexpr (!requires { backend.optimize(); }) out.trajectory.push_back(backend.pose().mean);
+    on_step(k);
+  });
+  if constexpr (requires { backend.optimize(); backend.trajectory(); }) {
+    detail::optimize_timed(backend, out);
+    for (const auto& pose : backend.pose_means()) out.trajectory.push_back(pose);
+    if (!out.trajectory.empty()) out.trajectory.erase(out.trajectory.begin());  // the start, not a step's pose
+  }
+  return out;
 }
 
 }  // namespace sextant::eval

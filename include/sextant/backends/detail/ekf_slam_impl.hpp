@@ -1,6 +1,7 @@
 #pragma once
 // Bodies of EkfSlam (see ../ekf_slam.hpp).
 
+#include <algorithm>
 #include <limits>
 #include <string>
 #include <utility>
@@ -264,6 +265,25 @@ auto EkfSlam<Motion, Sensor>::map() const -> MapEstimate {
   MapEstimate out;
   out.reserve(pool_.size());
   for (std::size_t slot = 0; slot < pool_.size(); ++slot) out.push_back(landmark_at(slot));
+  return out;
+}
+
+template <class Motion, class Sensor>
+auto EkfSlam<Motion, Sensor>::joint_marginal(std::span<const LandmarkId> ids) const -> JointMarginal<State, M> {
+  JointMarginal<State, M> out{x_, {ids.begin(), ids.end()}, {}, {}};
+  std::vector<Eigen::Index> rows(X);
+  for (Eigen::Index r = 0; r < X; ++r) rows[r] = r;
+  for (const LandmarkId id : ids) {
+    const std::size_t slot = pool_.slot(id);
+    out.landmarks.push_back(landmark_mean(slot));
+    for (Eigen::Index r = 0; r < M; ++r) rows.push_back(offset_of(slot) + r);
+  }
+  const auto lower = cov_.view();
+  const Eigen::Index n = static_cast<Eigen::Index>(rows.size());
+  out.cov.resize(n, n);
+  for (Eigen::Index c = 0; c < n; ++c)
+    for (Eigen::Index r = c; r < n; ++r)
+      out.cov(r, c) = out.cov(c, r) = lower(std::max(rows[r], rows[c]), std::min(rows[r], rows[c]));
   return out;
 }
 

@@ -70,16 +70,18 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
 
 /// H^T Q^-1 H and H^T Q^-1 nu of one observation, by blocks (thesis eqs. 29-30).
 template <class Motion, class Sensor>
-auto SeifSlam<Motion, Sensor>::measurement_information(const ObservationType& observation) const
-    -> MeasurementInformation {
+auto SeifSlam<Motion, Sensor>::linearize(const ObservationType& observation) const -> Linearized {
   const std::size_t slot = pool_.slot(observation.landmark_id);
-  const Linearized lin = linearize_observation(sensor_, x_, landmark_mean(slot), observation.z,
-                                               observation.landmark_id, offset_of(slot));
-  const auto llt = cholesky_or_throw(lin.Q, "measurement noise Q of landmark " + std::to_string(observation.landmark_id));
+  return linearize_observation(sensor_, x_, landmark_mean(slot), observation.z, observation.landmark_id, offset_of(slot));
+}
+
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::measurement_information(const Linearized& lin) const -> MeasurementInformation {
+  const auto llt = cholesky_or_throw(lin.Q, "measurement noise Q of landmark " + std::to_string(lin.id));
   const Eigen::Matrix<double, Z, X> W_Hx = llt.solve(lin.J_z_x);
   const Eigen::Matrix<double, Z, M> W_Hm = llt.solve(lin.J_z_m);
   const Eigen::Matrix<double, Z, 1> W_nu = llt.solve(lin.residual);
-  return {slot,
+  return {pool_.slot(lin.id),
           symmetrized(lin.J_z_x.transpose() * W_Hx),
           lin.J_z_x.transpose() * W_Hm,
           symmetrized(lin.J_z_m.transpose() * W_Hm),
@@ -123,14 +125,17 @@ void SeifSlam<Motion, Sensor>::augment(const NewLandmark& landmark) {
 template <class Motion, class Sensor>
 UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
   require_valid_observations(observations);
-  auto [all_known, fresh] = split_known_and_new(pool_, observations);
-  UpdateResult result{0, fresh.size(), {}};
-  const auto known = gate(std::move(all_known), result.rejected);
-  result.corrected = known.size();
+  const auto [known, fresh] = split_known_and_new(pool_, observations);
   // Linearize everything first; the rest runs as one transaction, undone if any step throws.
+  std::vector<Linearized> linearized;
+  linearized.reserve(known.size());
+  for (const auto& observation : known) linearized.push_back(linearize(observation));
+  UpdateResult result{0, fresh.size(), {}};
+  gate(linearized, result.rejected);
+  result.corrected = linearized.size();
   std::vector<MeasurementInformation> measurements;
-  measurements.reserve(known.size());
-  for (const auto& observation : known) measurements.push_back(measurement_information(observation));
+  measurements.reserve(linearized.size());
+  for (const auto& lin : linearized) measurements.push_back(measurement_information(lin));
   std::vector<NewLandmark> landmarks;
   landmarks.reserve(fresh.size());
   for (const auto& observation : fresh) landmarks.push_back(new_landmark(observation));
@@ -157,37 +162,31 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
   return result;
 }
 
-/// The chi-square test of each known observation with S = H Sigma H^T + Q, Sigma the joint
-/// marginal of the robot and the landmark: one multi-column solve with the factor of Omega.
+/// Removes the observations whose innovation fails the chi-square test, with S = H Sigma H^T + Q and
+/// Sigma the joint marginal of the robot and the landmark: one multi-column solve with the factor of Omega.
 template <class Motion, class Sensor>
-auto SeifSlam<Motion, Sensor>::gate(std::vector<ObservationType> known, std::vector<LandmarkId>& rejected) const
-    -> std::vector<ObservationType> {
-  if (!gate_.on() || known.empty()) return known;
-  const Eigen::Index k = static_cast<Eigen::Index>(known.size());
-  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(state_dim(), X + M * k);
-  unit.topLeftCorner(X, X).setIdentity();
-  for (Eigen::Index i = 0; i < k; ++i)
-    unit.block(offset_of(pool_.slot(known[i].landmark_id)), X + M * i, M, M).setIdentity();
-  const Eigen::MatrixXd columns = factorization()->solve(unit);
-  std::vector<ObservationType> kept;
-  for (Eigen::Index i = 0; i < k; ++i) {
-    const auto& observation = known[i];
-    const std::size_t slot = pool_.slot(observation.landmark_id);
-    const Linearized lin = linearize_observation(sensor_, x_, landmark_mean(slot), observation.z,
-                                                 observation.landmark_id, offset_of(slot));
-    const Eigen::Matrix<double, X, X> xx = columns.topLeftCorner(X, X);
-    const Eigen::Matrix<double, X, M> xm = columns.block(0, X + M * i, X, M);
-    const Eigen::Matrix<double, M, M> mm = columns.block(offset_of(slot), X + M * i, M, M);
+void SeifSlam<Motion, Sensor>::gate(std::vector<Linearized>& observations, std::vector<LandmarkId>& rejected) const {
+  if (!gate_.on() || observations.empty()) return;
+  std::vector<Eigen::Index> offsets;
+  for (const Linearized& lin : observations) offsets.push_back(lin.offset);
+  const Eigen::MatrixXd joint = joint_covariance(offsets);
+  const Eigen::Matrix<double, X, X> xx = joint.topLeftCorner(X, X);
+  std::vector<Linearized> kept;
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    const Linearized& lin = observations[i];
+    const Eigen::Index at = X + M * static_cast<Eigen::Index>(i);
+    const Eigen::Matrix<double, X, M> xm = joint.block(0, at, X, M);
+    const Eigen::Matrix<double, M, M> mm = joint.block(at, at, M, M);
     const Eigen::Matrix<double, Z, Z> S =
         symmetrized(lin.J_z_x * xx * lin.J_z_x.transpose() + lin.J_z_x * xm * lin.J_z_m.transpose() +
                     lin.J_z_m * xm.transpose() * lin.J_z_x.transpose() + lin.J_z_m * mm * lin.J_z_m.transpose() + lin.Q);
-    const auto llt = cholesky_or_throw(S, "innovation covariance of landmark " + std::to_string(observation.landmark_id));
+    const auto llt = cholesky_or_throw(S, "innovation covariance of landmark " + std::to_string(lin.id));
     if (gate_.rejects(llt, lin.residual))
-      rejected.push_back(observation.landmark_id);
+      rejected.push_back(lin.id);
     else
-      kept.push_back(observation);
+      kept.push_back(lin);
   }
-  return kept;
+  observations = std::move(kept);
 }
 
 /// Runs `step` so that it either completes or, if it throws, leaves the filter exactly as before:
@@ -444,6 +443,36 @@ Eigen::MatrixXd SeifSlam<Motion, Sensor>::marginal_covariance(Eigen::Index offse
   unit.block(offset, 0, size, size).setIdentity();
   const Eigen::MatrixXd columns = factorization()->solve(unit);
   return symmetrized(columns.block(offset, 0, size, size));
+}
+
+/// Columns of Omega^-1 for the robot and the given landmark blocks (one multi-column solve), kept
+/// at those rows: the joint marginal covariance.
+template <class Motion, class Sensor>
+Eigen::MatrixXd SeifSlam<Motion, Sensor>::joint_covariance(const std::vector<Eigen::Index>& offsets) const {
+  const Eigen::Index n = X + M * static_cast<Eigen::Index>(offsets.size());
+  std::vector<Eigen::Index> rows(X);
+  for (Eigen::Index r = 0; r < X; ++r) rows[r] = r;
+  for (const Eigen::Index offset : offsets)
+    for (Eigen::Index r = 0; r < M; ++r) rows.push_back(offset + r);
+  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(state_dim(), n);
+  for (Eigen::Index c = 0; c < n; ++c) unit(rows[c], c) = 1.0;
+  const Eigen::MatrixXd columns = factorization()->solve(unit);
+  Eigen::MatrixXd out(n, n);
+  for (Eigen::Index r = 0; r < n; ++r) out.row(r) = columns.row(rows[r]);
+  return symmetrized(out);
+}
+
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::joint_marginal(std::span<const LandmarkId> ids) const -> JointMarginal<State, M> {
+  JointMarginal<State, M> out{x_, {ids.begin(), ids.end()}, {}, {}};
+  std::vector<Eigen::Index> offsets;
+  for (const LandmarkId id : ids) {
+    const std::size_t slot = pool_.slot(id);
+    out.landmarks.push_back(landmark_mean(slot));
+    offsets.push_back(offset_of(slot));
+  }
+  out.cov = joint_covariance(offsets);
+  return out;
 }
 
 template <class Motion, class Sensor>

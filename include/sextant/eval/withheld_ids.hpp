@@ -1,0 +1,67 @@
+#pragma once
+/// \file A back-end run with the ids of its measurements withheld: every step's measurements go
+/// through DataAssociation (nearest neighbour or JCBB), the back-end sees only the ids the
+/// association hands out, and map() reports each landmark under the true id of the measurement
+/// that created it, so a run with unknown correspondences is scored like one with known ids.
+
+#include <span>
+#include <vector>
+
+#include "sextant/core/data_association.hpp"
+#include "sextant/core/update_result.hpp"
+#include "sextant/eval/association_score.hpp"
+
+namespace sextant::eval {
+
+template <class Backend, class Sensor>
+class WithheldIds {
+ public:
+  using State = typename Backend::State;
+  using Control = typename Backend::Control;
+  using Space = typename Backend::Space;
+  using ObservationType = typename Backend::ObservationType;
+  using Measurement = typename Sensor::Measurement;
+
+  WithheldIds(Backend& backend, Sensor sensor, AssociationOptions options)
+      : backend_(backend), association_(std::move(sensor), options) {}
+
+  void predict(const Control& u, double dt) { backend_.predict(u, dt); }
+
+  /// Associates the measurements (their ids are used only to score the association), then updates.
+  UpdateResult update(std::span<const ObservationType> observations) {
+    std::vector<Measurement> z;
+    std::vector<LandmarkId> truth;
+    for (const auto& o : observations) {
+      z.push_back(o.z);
+      truth.push_back(o.landmark_id);
+    }
+    const auto result = association_.associate(backend_, std::span<const Measurement>(z));
+    const UpdateResult update = backend_.update(result.observations);
+    score_.record(std::span<const LandmarkId>(truth), result);
+    if (!result.search_complete) ++incomplete_searches_;
+    return update;
+  }
+  UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }
+
+  auto pose() const { return backend_.pose(); }
+  /// The back-end's map, each landmark under the true id of the measurement that created it.
+  auto map() const {
+    auto map = backend_.map();
+    for (auto& landmark : map) landmark.id = score_.truth_of(landmark.id).value_or(landmark.id);
+    return map;
+  }
+  /// Removes a landmark by the id the association gave it.
+  void remove_landmark(LandmarkId id) { backend_.remove_landmark(id); }
+
+  const AssociationScore& score() const { return score_; }
+  /// Steps where JCBB stopped at its node limit with the best hypothesis found so far.
+  std::size_t incomplete_searches() const { return incomplete_searches_; }
+
+ private:
+  Backend& backend_;
+  DataAssociation<Sensor> association_;
+  AssociationScore score_;
+  std::size_t incomplete_searches_ = 0;
+};
+
+}  // namespace sextant::eval

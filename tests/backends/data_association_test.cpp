@@ -1,0 +1,221 @@
+// Data association for measurements without ids (issue 14): nearest neighbour and JCBB on hand-made
+// cases whose answer is known, the joint marginal EKF and SEIF hand to it, and whole runs of the
+// thesis's ship with its ids withheld, scored against the run that knows them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sextant/backends/ekf_slam.hpp"
+#include "sextant/backends/seif_slam.hpp"
+#include "sextant/core/data_association.hpp"
+#include "sextant/eval/association_score.hpp"
+#include "sextant/eval/withheld_ids.hpp"
+#include "sextant/models/beacon_ship_2d.hpp"
+#include "sextant/models/point_in_robot_frame_2d.hpp"
+#include "sextant/sim/ship_2d.hpp"
+
+namespace sextant {
+namespace {
+
+using Joint = JointMarginal<Eigen::Vector3d, 2>;
+
+PointInRobotFrame2D sensor_with_sigma(double sigma) {
+  PointInRobotFrame2D sensor;
+  sensor.Q = sigma * sigma * Eigen::Matrix2d::Identity();
+  return sensor;
+}
+
+/// Landmarks A = (5, 0), B = (5, 1), C = (5, 2) known to 1 cm; the robot, truly at the origin, is
+/// believed 0.6 m to the north with sigma 0.5 m, so every landmark is predicted 0.6 m south of where it is seen.
+Joint row_of_three() {
+  Joint joint{Eigen::Vector3d(0.0, 0.6, 0.0), {10, 11, 12}, {{5.0, 0.0}, {5.0, 1.0}, {5.0, 2.0}}, {}};
+  joint.cov = Eigen::MatrixXd::Zero(9, 9);
+  joint.cov.diagonal() << 0.25, 0.25, 1e-6, 1e-4, 1e-4, 1e-4, 1e-4, 1e-4, 1e-4;
+  return joint;
+}
+
+TEST(DataAssociation, JcbbFindsTheJointHypothesisWhereNearestNeighbourFails) {
+  // A and C are seen. Alone, A's measurement (5, 0) is nearer to B's prediction (5, 0.4) than to A's
+  // (5, -0.6), so nearest neighbour pairs it with B. But both measurements share the robot's error:
+  // (A, C) explains them with one common 0.6 m shift, (B, C) needs shifts of -0.4 and +0.6 at once,
+  // which landmarks known to 1 cm and a 5 cm sensor cannot give.
+  const Joint joint = row_of_three();
+  const std::vector<Eigen::Vector2d> z = {{5.0, 0.0}, {5.0, 2.0}};
+  AssociationOptions nn_options;
+  nn_options.method = AssociationMethod::nearest_neighbour;
+  DataAssociation nn(sensor_with_sigma(0.05), nn_options);
+  DataAssociation jcbb(sensor_with_sigma(0.05));
+
+  const auto by_nn = nn.associate(joint, std::span(z));
+  const auto by_jcbb = jcbb.associate(joint, std::span(z));
+
+  ASSERT_EQ(by_nn.paired, 2u);
+  EXPECT_EQ(by_nn.id[0], 11u) << "nearest neighbour is expected to take the nearer, wrong landmark B";
+  EXPECT_EQ(by_nn.id[1], 12u);
+  EXPECT_GT(by_nn.joint_nis, chi_square_quantile(4, 0.99)) << "and its pairing is jointly incompatible";
+  ASSERT_EQ(by_jcbb.paired, 2u);
+  EXPECT_EQ(by_jcbb.id[0], 10u);
+  EXPECT_EQ(by_jcbb.id[1], 12u);
+  EXPECT_LT(by_jcbb.joint_nis, chi_square_quantile(4, 0.99));
+  EXPECT_TRUE(by_jcbb.search_complete);
+  EXPECT_EQ(by_jcbb.observations.size(), 2u);
+}
+
+TEST(DataAssociation, FarMeasurementStartsALandmarkAndASecondClaimOnOneLandmarkIsDiscarded) {
+  Joint joint = row_of_three();
+  joint.robot = Eigen::Vector3d::Zero();
+  joint.cov.diagonal().head<3>().setConstant(1e-6);
+  // (5, 0.02) and (5, -0.02) both fit A only; (40, 40) fits nothing.
+  const std::vector<Eigen::Vector2d> z = {{5.0, 0.02}, {40.0, 40.0}, {5.0, -0.02}};
+  for (const auto method : {AssociationMethod::nearest_neighbour, AssociationMethod::joint_compatibility}) {
+    AssociationOptions options;
+    options.method = method;
+    DataAssociation association(sensor_with_sigma(0.05), options, 1000);
+    const auto result = association.associate(joint, std::span(z));
+    ASSERT_EQ(result.outcome.size(), 3u);
+    EXPECT_EQ(result.paired, 1u);
+    EXPECT_EQ(result.created, 1u);
+    EXPECT_EQ(result.discarded, 1u);
+    EXPECT_EQ(result.outcome[1], AssociationOutcome::new_landmark);
+    EXPECT_EQ(result.id[1], 1000u);
+    EXPECT_EQ(association.next_new_id(), 1001u);
+    const bool first_paired = result.outcome[0] == AssociationOutcome::paired;
+    EXPECT_EQ(result.id[first_paired ? 0 : 2], 10u);
+    EXPECT_EQ(result.outcome[first_paired ? 2 : 0], AssociationOutcome::discarded);
+    ASSERT_EQ(result.observations.size(), 2u) << "the discarded measurement is not handed to update()";
+  }
+}
+
+TEST(DataAssociation, EmptyMapMakesEveryMeasurementNew) {
+  const Joint empty{Eigen::Vector3d::Zero(), {}, {}, 1e-4 * Eigen::MatrixXd::Identity(3, 3)};
+  const std::vector<Eigen::Vector2d> z = {{1.0, 0.0}, {2.0, 0.0}};
+  DataAssociation association(sensor_with_sigma(0.05), {}, 7);
+  const auto result = association.associate(empty, std::span(z));
+  EXPECT_EQ(result.created, 2u);
+  EXPECT_EQ(result.observations[0].landmark_id, 7u);
+  EXPECT_EQ(result.observations[1].landmark_id, 8u);
+}
+
+TEST(DataAssociation, BadInputNamesTheProblem) {
+  const Joint joint = row_of_three();
+  DataAssociation association(sensor_with_sigma(0.05));
+  const std::vector<Eigen::Vector2d> z = {{5.0, 0.0}, {NAN, 1.0}};
+  try {
+    association.associate(joint, std::span(z));
+    FAIL() << "a NaN measurement was associated";
+  } catch (const invalid_input_error& e) {
+    EXPECT_NE(std::string(e.what()).find("measurement 1"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(association.next_new_id(), LandmarkId{1} << 61) << "no id was spent";
+  AssociationOptions bad;
+  bad.gate_probability = 1.0;
+  EXPECT_THROW(DataAssociation(sensor_with_sigma(0.05), bad), invalid_input_error);
+  bad.gate_probability = 0.99;
+  bad.new_landmark_probability = 0.5;
+  EXPECT_THROW(DataAssociation(sensor_with_sigma(0.05), bad), invalid_input_error);
+}
+
+// The thesis's ship (linear models): EKF and SEIF without sparsification hold the same Gaussian,
+// so they hand the association the same joint marginal.
+using ShipEkf = EkfSlam<BeaconShip2D, BeaconOffset2D>;
+using ShipSeif = SeifSlam<BeaconShip2D, BeaconOffset2D>;
+
+sim::Ship2DDataset short_ship() {
+  sim::Ship2DOptions options;
+  options.num_steps = 120;
+  return sim::simulate_ship_2d(options);
+}
+
+TEST(DataAssociation, EkfAndSeifGiveTheSameJointMarginal) {
+  const auto data = short_ship();
+  ShipEkf ekf(data.motion, data.sensor, data.prior);
+  SeifOptions seif_options;
+  seif_options.exact_recovery_period = 1;
+  ShipSeif seif(data.motion, data.sensor, data.prior, seif_options);
+  for (const auto& step : data.steps) {
+    ekf.predict(step.control, step.dt);
+    seif.predict(step.control, step.dt);
+    ekf.update(step.observations);
+    seif.update(step.observations);
+  }
+  ASSERT_GE(ekf.num_landmarks(), 3u);
+  const std::vector<LandmarkId> ids = {ekf.landmark_ids()[2], ekf.landmark_ids()[0]};
+  const auto a = ekf.joint_marginal(ids);
+  const auto b = seif.joint_marginal(ids);
+  EXPECT_EQ(a.ids, b.ids);
+  EXPECT_LT((a.robot - b.robot).norm(), 1e-9);
+  for (std::size_t i = 0; i < ids.size(); ++i) EXPECT_LT((a.landmarks[i] - b.landmarks[i]).norm(), 1e-9);
+  EXPECT_LT((a.cov - b.cov).cwiseAbs().maxCoeff(), 1e-9 * a.cov.cwiseAbs().maxCoeff());
+  const Eigen::MatrixXd full = ekf.covariance();
+  const Eigen::Index s2 = 2 + 2 * 2, s0 = 2;  // slots 2 and 0
+  EXPECT_EQ(a.cov.block(2, 4, 2, 2), full.block(s2, s0, 2, 2)) << "the cross block of landmarks 2 and 0";
+  EXPECT_THROW(ekf.joint_marginal(std::vector<LandmarkId>{999999}), unknown_landmark_error);
+  EXPECT_THROW(seif.joint_marginal(std::vector<LandmarkId>{999999}), unknown_landmark_error);
+}
+
+struct ShipRun {
+  double rmse = 0.0;
+  eval::AssociationScore score;
+};
+
+/// Runs the whole ship route, associating with `method` when set (ids withheld, eval::WithheldIds)
+/// or with the simulator's ids when not.
+template <class Estimator>
+ShipRun run_ship(Estimator estimator, const sim::Ship2DDataset& data, std::optional<AssociationMethod> method) {
+  AssociationOptions options;
+  if (method) options.method = *method;
+  eval::WithheldIds withheld(estimator, data.sensor, options);
+  ShipRun run;
+  double squared = 0.0;
+  for (std::size_t k = 0; k < data.steps.size(); ++k) {
+    const auto& step = data.steps[k];
+    estimator.predict(step.control, step.dt);
+    if (method)
+      withheld.update(step.observations);
+    else
+      estimator.update(step.observations);
+    squared += (estimator.pose().mean - data.true_poses[k + 1]).squaredNorm();
+  }
+  run.rmse = std::sqrt(squared / static_cast<double>(data.steps.size()));
+  run.score = withheld.score();
+  return run;
+}
+
+// The whole route (1390 steps, 2 km beacon noise, beacons 100 km apart with 20 km jitter) closes its
+// loop after the open-sea leg, where the pose has drifted by tens of km. The margins: precision and
+// recall of 0.98 leave room for the 1% of true pairings a 0.99 gate rejects and a few misses at the
+// loop closure; the pose error within 1.5x of the run that knows the ids is the issue's goal.
+template <class Estimator>
+void expect_association_close_to_known_ids(const Estimator& prototype, const char* name) {
+  const auto data = sim::simulate_ship_2d({});
+  const ShipRun known = run_ship(prototype, data, std::nullopt);
+  const ShipRun jcbb = run_ship(prototype, data, AssociationMethod::joint_compatibility);
+  EXPECT_GE(jcbb.score.precision(), 0.98) << name << ": wrong pairings " << jcbb.score.wrong();
+  EXPECT_GE(jcbb.score.recall(), 0.98) << name << ": duplicates " << jcbb.score.duplicates() << ", discarded "
+                                       << jcbb.score.discarded();
+  EXPECT_LE(jcbb.rmse, 1.5 * known.rmse) << name << ": known ids " << known.rmse << " km, JCBB " << jcbb.rmse << " km";
+  std::printf("%s on the ship: known ids RMSE %.3f km; JCBB RMSE %.3f km, precision %.4f, recall %.4f, "
+              "%zu wrong, %zu duplicates, %zu discarded\n",
+              name, known.rmse, jcbb.rmse, jcbb.score.precision(), jcbb.score.recall(), jcbb.score.wrong(),
+              jcbb.score.duplicates(), jcbb.score.discarded());
+}
+
+TEST(DataAssociation, EkfWithJcbbOnTheShipMatchesTheRunThatKnowsTheIds) {
+  const auto data = sim::simulate_ship_2d({});
+  expect_association_close_to_known_ids(ShipEkf(data.motion, data.sensor, data.prior), "EKF");
+}
+
+// SEIF without sparsification holds the EKF's Gaussian, so its association must do as well; a
+// sparsified SEIF's marginals are overconfident (Eustice et al. 2005) and its association is
+// measured in docs/data_association.md, not bounded here.
+TEST(DataAssociation, SeifWithJcbbOnTheShipMatchesTheRunThatKnowsTheIds) {
+  const auto data = sim::simulate_ship_2d({});
+  expect_association_close_to_known_ids(ShipSeif(data.motion, data.sensor, data.prior), "SEIF (all active)");
+}
+
+}  // namespace
+}  // namespace sextant
