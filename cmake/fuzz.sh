@@ -28,6 +28,17 @@ for f in "$mrpt"/datasets/kf-slam_demo.rawlog "$mrpt"/datasets/kf-slam_6D_demo.r
 for f in "$mrpt"/config_files/kf-slam/EKF-SLAM_test_2d.ini "$mrpt"/config_files/kf-slam/EKF-SLAM_6D_test.ini; do
   seed runner_config_fuzz "$f"
 done
+# MRCLAM: the five files of robot 1 (their first 2 KB), joined with "%%" lines as the target splits them.
+mrclam=$shared/mrclam/MRCLAM_Dataset6
+if [ -d "$mrclam" ]; then
+  mkdir -p "$corpus/mrclam_reader_fuzz"
+  for f in Barcodes Landmark_Groundtruth Robot1_Odometry Robot1_Measurement Robot1_Groundtruth; do
+    head -c 2048 "$mrclam/$f.dat" | sed '$d'
+    echo "%%"
+  done > "$corpus/mrclam_reader_fuzz/dataset6_robot1"
+else
+  echo "fuzz: seed $mrclam not found, skipped"
+fi
 mkdir -p "$corpus/runner_config_fuzz"
 printf '[ship]\nruns = 2\nsigma_heading_deg = 15\n[ekf]\ncovariance_update = joseph\n[seif]\nmax_active = 4 // four\n[globe]\nseif_active = 4 8\n' \
   > "$corpus/runner_config_fuzz/sextant.ini"
