@@ -111,6 +111,13 @@ inline std::string without_comment(std::string value) {
   return first == std::string::npos ? std::string() : value.substr(first, last - first + 1);
 }
 
+/// A probability in (0, 1).
+inline double parse_probability(const std::string& text) {
+  const double p = parse_number(text);
+  if (!(p > 0.0 && p < 1.0)) throw invalid_input_error("'" + text + "' must be in (0, 1)");
+  return p;
+}
+
 /// A gate probability: 0 (off) or in (0, 1).
 inline double parse_gate_probability(const std::string& text) {
   const double p = parse_number(text);
@@ -227,19 +234,11 @@ inline const std::vector<ConfigKey>& config_keys() {
                  {"jcbb", AssociationMethod::joint_compatibility}});
        }},
       {"association", "gate_probability", "0.99", "chi-square gate of individual and joint compatibility",
-       [](RunnerConfig& c, const std::string& v) {
-         const double p = parse_number(v);
-         if (!(p > 0.0 && p < 1.0)) throw invalid_input_error("'" + v + "' must be in (0, 1)");
-         c.association.options.gate_probability = p;
-       }},
+       [](RunnerConfig& c, const std::string& v) { c.association.options.gate_probability = parse_probability(v); }},
       {"association", "new_landmark_probability", "0.9999",
        "a measurement outside every landmark's gate at this probability starts a new landmark; inside one but unpaired "
        "it is discarded",
-       [](RunnerConfig& c, const std::string& v) {
-         const double p = parse_number(v);
-         if (!(p > 0.0 && p < 1.0)) throw invalid_input_error("'" + v + "' must be in (0, 1)");
-         c.association.options.new_landmark_probability = p;
-       }},
+       [](RunnerConfig& c, const std::string& v) { c.association.options.new_landmark_probability = parse_probability(v); }},
       {"ekf", "batch_update", "true", "one joint correction per step (true) or one per observation (false)",
        [](RunnerConfig& c, const std::string& v) { c.ekf.batch_update = parse_bool(v); }},
       {"ekf", "covariance_update", "symmetric", "symmetric (lower-triangle rank update) | joseph",

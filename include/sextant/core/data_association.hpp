@@ -85,7 +85,6 @@ class DataAssociation {
   /// joint_marginal(ids) (EKF, SEIF) against its whole map.
   template <class Estimator>
   AssociationResult<Measurement> associate(const Estimator& estimator, std::span<const Measurement> measurements) {
-    require_finite_measurements(measurements);
     return associate(estimator.joint_marginal(estimator.landmark_ids()), measurements);
   }
 

@@ -20,4 +20,16 @@ struct JointMarginal {
   Eigen::Index offset(std::size_t i) const { return cov.rows() - M * static_cast<Eigen::Index>(ids.size() - i); }
 };
 
+/// The rows of the joint (robot, landmark blocks at `offsets`) in a stacked state whose robot block
+/// comes first: 0 .. X-1, then offset .. offset+M-1 for each block in order.
+template <int X, int M>
+std::vector<Eigen::Index> joint_rows(const std::vector<Eigen::Index>& offsets) {
+  std::vector<Eigen::Index> rows;
+  rows.reserve(X + M * offsets.size());
+  for (Eigen::Index r = 0; r < X; ++r) rows.push_back(r);
+  for (const Eigen::Index offset : offsets)
+    for (Eigen::Index r = 0; r < M; ++r) rows.push_back(offset + r);
+  return rows;
+}
+
 }  // namespace sextant

@@ -271,13 +271,13 @@ auto EkfSlam<Motion, Sensor>::map() const -> MapEstimate {
 template <class Motion, class Sensor>
 auto EkfSlam<Motion, Sensor>::joint_marginal(std::span<const LandmarkId> ids) const -> JointMarginal<State, M> {
   JointMarginal<State, M> out{x_, {ids.begin(), ids.end()}, {}, {}};
-  std::vector<Eigen::Index> rows(X);
-  for (Eigen::Index r = 0; r < X; ++r) rows[r] = r;
+  std::vector<Eigen::Index> offsets;
   for (const LandmarkId id : ids) {
     const std::size_t slot = pool_.slot(id);
     out.landmarks.push_back(landmark_mean(slot));
-    for (Eigen::Index r = 0; r < M; ++r) rows.push_back(offset_of(slot) + r);
+    offsets.push_back(offset_of(slot));
   }
+  const auto rows = joint_rows<X, M>(offsets);
   const auto lower = cov_.view();
   const Eigen::Index n = static_cast<Eigen::Index>(rows.size());
   out.cov.resize(n, n);

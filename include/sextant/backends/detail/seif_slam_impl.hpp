@@ -449,11 +449,8 @@ Eigen::MatrixXd SeifSlam<Motion, Sensor>::marginal_covariance(Eigen::Index offse
 /// at those rows: the joint marginal covariance.
 template <class Motion, class Sensor>
 Eigen::MatrixXd SeifSlam<Motion, Sensor>::joint_covariance(const std::vector<Eigen::Index>& offsets) const {
-  const Eigen::Index n = X + M * static_cast<Eigen::Index>(offsets.size());
-  std::vector<Eigen::Index> rows(X);
-  for (Eigen::Index r = 0; r < X; ++r) rows[r] = r;
-  for (const Eigen::Index offset : offsets)
-    for (Eigen::Index r = 0; r < M; ++r) rows.push_back(offset + r);
+  const auto rows = joint_rows<X, M>(offsets);
+  const Eigen::Index n = static_cast<Eigen::Index>(rows.size());
   Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(state_dim(), n);
   for (Eigen::Index c = 0; c < n; ++c) unit(rows[c], c) = 1.0;
   const Eigen::MatrixXd columns = factorization()->solve(unit);
