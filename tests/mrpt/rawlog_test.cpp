@@ -10,7 +10,7 @@
 #include <numbers>
 
 #include "mrpt/mrpt_demo_data.hpp"
-#include "support/bounded_new.hpp"  // this binary's operator new throws above 1 GiB (see the corrupt-length test)
+#include "support/bounded_new.hpp"  // this binary's operator new throws above 256 MiB (see the corrupt-length tests)
 #include "support/nees_bound.hpp"
 #include "support/temp_path.hpp"
 #ifdef SEXTANT_HAS_MRPT_SLAM
@@ -264,28 +264,60 @@ TEST_F(WrittenRawlog, BadLogsGiveOneLineErrorsNamingFileAndProblem) {
     EXPECT_EQ(error_of(path).find('\n'), std::string::npos) << path;
 }
 
-// Fuzz finding 3 (docs/reliability.md): a corrupt length field makes MRPT's deserializer ask for
-// tens of gigabytes. This binary's operator new throws std::bad_alloc above 1 GiB
+// Fuzz findings 3 to 5 (docs/reliability.md): a corrupt length field makes MRPT's deserializer
+// ask for gigabytes. This binary's operator new throws std::bad_alloc above 256 MiB
 // (support/bounded_new.hpp), as new does on a machine without that memory, so the test never asks
 // the system for it; the reader must turn it into a one-line parse_error.
-TEST_F(WrittenRawlog, CorruptLengthFieldIsAMalformedLogNotACrash) {
+class CorruptLengthField : public WrittenRawlog {
+ protected:
+  /// Writes a log, overwrites the 4-byte field holding `field` (which must occur exactly once)
+  /// with `value` and returns the reader's error.
+  template <class... Objects>
+  std::string error_after_corrupting(std::uint32_t field, std::uint32_t value, const Objects&... objects) {
+    const auto path = write("long.rawlog", true, objects...);
+    std::ifstream in(path, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string pattern(reinterpret_cast<const char*>(&field), sizeof field);
+    const auto at = bytes.find(pattern);
+    if (at == std::string::npos || bytes.find(pattern, at + 1) != std::string::npos) {
+      ADD_FAILURE() << "the field " << field << " does not occur exactly once in the log";
+      return {};
+    }
+    bytes.replace(at, sizeof value, reinterpret_cast<const char*>(&value), sizeof value);
+    const auto corrupt = (dir / "corrupt.rawlog").string();
+    std::ofstream(corrupt, std::ios::binary) << bytes;
+    return error_of(corrupt);
+  }
+  void expect_malformed_entry_1(const std::string& message) {
+    EXPECT_NE(message.find((dir / "corrupt.rawlog").string() + ": entry 1: truncated or malformed"), std::string::npos)
+        << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos);
+  }
+};
+
+TEST_F(CorruptLengthField, MeasurementCountIsAMalformedLogNotACrash) {
   constexpr std::uint32_t kCount = 2827;  // measurements: a length field that occurs nowhere else in the log
   std::vector<std::pair<int, float>> many;
   for (std::uint32_t i = 0; i < kCount; ++i) many.push_back({static_cast<int>(i), 2.0f});  // ids below kCount
-  const auto path = write("long.rawlog", true, action(0.5, 0.0, 0.1), frame(bearing(many)));
-  std::ifstream in(path, std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string field(reinterpret_cast<const char*>(&kCount), sizeof kCount);
-  const auto at = bytes.find(field);
-  ASSERT_NE(at, std::string::npos) << "the measurement count is not in the log";
-  ASSERT_EQ(bytes.find(field, at + 1), std::string::npos) << "the measurement count occurs twice";
-  constexpr std::uint32_t kHuge = 0x7fffffff;
-  bytes.replace(at, sizeof kHuge, reinterpret_cast<const char*>(&kHuge), sizeof kHuge);
-  const auto corrupt = (dir / "corrupt.rawlog").string();
-  std::ofstream(corrupt, std::ios::binary) << bytes;
-  const auto message = error_of(corrupt);
-  EXPECT_NE(message.find(corrupt + ": entry 1: truncated or malformed"), std::string::npos) << message;
-  EXPECT_EQ(message.find('\n'), std::string::npos);
+  expect_malformed_entry_1(error_after_corrupting(kCount, 0x7fffffff, action(0.5, 0.0, 0.1), frame(bearing(many))));
+}
+
+TEST_F(CorruptLengthField, ObservationCountOfAFrameIsAMalformedLogNotACrash) {
+  // A second finding of 2026-11-23: MRPT resizes the frame's std::deque of observations to the
+  // count it reads, in small chunks no single-request bound catches (bounded_new.hpp's total bound).
+  constexpr std::uint32_t kObservations = 1999;
+  auto sf = ::mrpt::obs::CSensoryFrame::Create();
+  for (std::uint32_t i = 0; i < kObservations; ++i) sf->insert(bearing({{static_cast<int>(i), 2.0f}}));
+  expect_malformed_entry_1(error_after_corrupting(kObservations, 0x7fffffff, action(0.5, 0.0, 0.1), sf));
+}
+
+TEST_F(CorruptLengthField, StringLengthIsAMalformedLogNotACrash) {
+  // The CI finding: the length of the observation's sensor label set to 1061109568.
+  const std::string label = "a label of thirty-nine characters, odd.";
+  auto observation = bearing({{1, 2.0f}});
+  observation->sensorLabel = label;
+  expect_malformed_entry_1(error_after_corrupting(static_cast<std::uint32_t>(label.size()), 1061109568u,
+                                                  action(0.5, 0.0, 0.1), frame(observation)));
 }
 
 TEST_F(WrittenRawlog, GroundTruthMustCoverEveryStepAndLandmark) {

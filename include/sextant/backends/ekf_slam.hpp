@@ -119,6 +119,12 @@ class EkfSlam {
 
   std::vector<Linearized> linearize(std::span<const ObservationType> known) const;
   Eigen::Matrix<double, Eigen::Dynamic, Z> cross_covariance(const Linearized& obs) const;
+  /// H_i C: observation i's Jacobian applied to C (rows of the stacked state), from the robot and
+  /// landmark rows only.
+  template <class Matrix>
+  static Eigen::Matrix<double, Z, Eigen::Dynamic> jacobian_times(const Linearized& obs, const Matrix& C) {
+    return obs.J_z_x * C.template topRows<X>() + obs.J_z_m * C.template middleRows<M>(obs.offset);
+  }
   void gate(std::vector<Linearized>& observations, UpdateResult& result) const;
   Correction compute_correction(const std::vector<Linearized>& observations) const;
   Eigen::MatrixXd joseph_covariance(const std::vector<Linearized>& observations, const Eigen::MatrixXd& K) const;

@@ -125,14 +125,8 @@ class DataAssociation {
   /// Innovation covariance cross block H_p Sigma H_q^T (+ Q when p is q) of two pairings.
   template <class State>
   static Eigen::Matrix<double, Z, Z> innovation_block(const JointMarginal<State, M>& joint, const Pair& p, const Pair& q) {
-    const Eigen::Index X = joint.offset(0);
-    const Eigen::Index a = joint.offset(p.landmark), b = joint.offset(q.landmark);
-    const auto& S = joint.cov;
-    Eigen::Matrix<double, Z, Z> out =
-        p.J_z_x * S.block(0, 0, X, X) * q.J_z_x.transpose() +
-        p.J_z_x * S.block(0, b, X, M) * q.J_z_m.transpose() +
-        p.J_z_m * S.block(a, 0, M, X) * q.J_z_x.transpose() +
-        p.J_z_m * S.block(a, b, M, M) * q.J_z_m.transpose();
+    Eigen::Matrix<double, Z, Z> out = innovation_cross_block(joint.cov, p.J_z_x, p.J_z_m, joint.offset(p.landmark),
+                                                             q.J_z_x, q.J_z_m, joint.offset(q.landmark));
     if (&p == &q) out += p.Q;
     return out;
   }

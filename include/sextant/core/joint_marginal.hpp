@@ -32,4 +32,20 @@ std::vector<Eigen::Index> joint_rows(const std::vector<Eigen::Index>& offsets) {
   return rows;
 }
 
+/// One block of the innovation covariance of observations p and q, each linearized in the robot
+/// (rows 0 .. X-1 of `cov`) and one landmark (rows a .. a+M-1 and b .. b+M-1):
+/// H_p Sigma H_q^T, thesis eq. (15) without Q. Data association needs the cross blocks (p != q);
+/// a gate needs the diagonal ones, to which it adds Q.
+template <class CovP, class Jx, class Jm, class JxQ, class JmQ>
+auto innovation_cross_block(const Eigen::MatrixBase<CovP>& cov, const Jx& J_x_p, const Jm& J_m_p, Eigen::Index a,
+                            const JxQ& J_x_q, const JmQ& J_m_q, Eigen::Index b) {
+  constexpr int Z = Jm::RowsAtCompileTime, M = Jm::ColsAtCompileTime;
+  const Eigen::Index X = J_x_p.cols();
+  Eigen::Matrix<double, Z, Z> out = J_x_p * cov.block(0, 0, X, X) * J_x_q.transpose() +
+                                    J_x_p * cov.block(0, b, X, M) * J_m_q.transpose() +
+                                    J_m_p * cov.block(a, 0, M, X) * J_x_q.transpose() +
+                                    J_m_p * cov.block(a, b, M, M) * J_m_q.transpose();
+  return out;
+}
+
 }  // namespace sextant

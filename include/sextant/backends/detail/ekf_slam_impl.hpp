@@ -91,9 +91,7 @@ void EkfSlam<Motion, Sensor>::gate(std::vector<Linearized>& observations, Update
   if (!gate_.on()) return;
   std::vector<Linearized> kept;
   for (auto& obs : observations) {
-    const auto C = cross_covariance(obs);
-    const Eigen::Matrix<double, Z, Z> S = symmetrized(
-        obs.J_z_x * C.template topRows<X>() + obs.J_z_m * C.template middleRows<M>(obs.offset) + obs.Q);
+    const Eigen::Matrix<double, Z, Z> S = symmetrized(jacobian_times(obs, cross_covariance(obs)) + obs.Q);
     const auto llt = cholesky_or_throw(S, "innovation covariance of landmark " + std::to_string(obs.id));
     if (gate_.rejects(llt, obs.residual))
       result.rejected.push_back(obs.id);
@@ -117,8 +115,7 @@ auto EkfSlam<Motion, Sensor>::compute_correction(const std::vector<Linearized>& 
   Eigen::MatrixXd S(Z * k, Z * k);
   for (Eigen::Index i = 0; i < k; ++i) {
     const auto& obs = observations[i];
-    S.template middleRows<Z>(Z * i) =
-        obs.J_z_x * C.template topRows<X>() + obs.J_z_m * C.template middleRows<M>(obs.offset);
+    S.template middleRows<Z>(Z * i) = jacobian_times(obs, C);
     S.template block<Z, Z>(Z * i, Z * i) += obs.Q;
   }
   const auto llt = cholesky_or_throw(symmetrized(S), "innovation covariance S");

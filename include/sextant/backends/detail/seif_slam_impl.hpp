@@ -170,16 +170,12 @@ void SeifSlam<Motion, Sensor>::gate(std::vector<Linearized>& observations, std::
   std::vector<Eigen::Index> offsets;
   for (const Linearized& lin : observations) offsets.push_back(lin.offset);
   const Eigen::MatrixXd joint = joint_covariance(offsets);
-  const Eigen::Matrix<double, X, X> xx = joint.topLeftCorner(X, X);
   std::vector<Linearized> kept;
   for (std::size_t i = 0; i < observations.size(); ++i) {
     const Linearized& lin = observations[i];
     const Eigen::Index at = X + M * static_cast<Eigen::Index>(i);
-    const Eigen::Matrix<double, X, M> xm = joint.block(0, at, X, M);
-    const Eigen::Matrix<double, M, M> mm = joint.block(at, at, M, M);
     const Eigen::Matrix<double, Z, Z> S =
-        symmetrized(lin.J_z_x * xx * lin.J_z_x.transpose() + lin.J_z_x * xm * lin.J_z_m.transpose() +
-                    lin.J_z_m * xm.transpose() * lin.J_z_x.transpose() + lin.J_z_m * mm * lin.J_z_m.transpose() + lin.Q);
+        symmetrized(innovation_cross_block(joint, lin.J_z_x, lin.J_z_m, at, lin.J_z_x, lin.J_z_m, at) + lin.Q);
     const auto llt = cholesky_or_throw(S, "innovation covariance of landmark " + std::to_string(lin.id));
     if (gate_.rejects(llt, lin.residual))
       rejected.push_back(lin.id);
