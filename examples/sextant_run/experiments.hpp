@@ -5,7 +5,9 @@
 #include <optional>
 #include <sextant/eval/experiment.hpp>
 #include <sextant/eval/monte_carlo.hpp>
+#include <sextant/eval/particle_association.hpp>
 #include <sextant/eval/withheld_ids.hpp>
+#include <sextant/io/landmark_dataset.hpp>
 #include <string>
 #include <vector>
 
@@ -26,8 +28,9 @@ struct BackendRun {
   std::optional<eval::AssociationScore> association;  ///< when the ids were withheld
 };
 
-/// Whether a back-end can run with its ids withheld (it hands data association its joint marginal).
-inline bool associates(BackendKind kind) { return kind == BackendKind::ekf || kind == BackendKind::seif; }
+/// Whether a back-end can run with its ids withheld: EKF and SEIF hand data association their joint
+/// marginal; FastSLAM associates per particle by maximum likelihood whatever the method.
+inline bool associates(BackendKind kind) { return kind != BackendKind::graph; }
 
 inline AssociationRow association_row(const eval::AssociationScore& a) {
   return {a.precision(), a.recall(), a.wrong(), a.duplicates(), a.discarded()};
@@ -36,7 +39,7 @@ inline AssociationRow association_row(const eval::AssociationScore& a) {
 /// Whether `kind` sits this data set out because the ids are withheld and it cannot associate.
 inline bool left_out(BackendKind kind, const RunnerConfig& c, const std::string& dataset) {
   if (!c.association.method || associates(kind)) return false;
-  std::printf("%s: %s needs known ids, left out (--associate is for EKF and SEIF)\n", dataset.c_str(),
+  std::printf("%s: %s needs known ids, left out (--associate is for EKF, SEIF and FastSLAM)\n", dataset.c_str(),
               backend_key(kind).c_str());
   return true;
 }
@@ -93,7 +96,12 @@ BackendRun<Dataset> run_backend(BackendKind kind, const Dataset& data, const Run
       FastSlamOptions o = c.fastslam;
       o.version = kind == BackendKind::fastslam1 ? FastSlamVersion::v1 : FastSlamVersion::v2;
       FastSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, o);
-      finish(b, evaluate(b));
+      if (c.association.method) {  // per-particle maximum likelihood, whatever the method
+        eval::ParticleAssociation withheld(b);
+        finish(withheld, evaluate(withheld));
+      } else {
+        finish(b, evaluate(b));
+      }
       break;
     }
   }
@@ -106,6 +114,13 @@ std::vector<TableRow> run_on_rawlog(const std::string& name, const Dataset& data
                                     const RunnerConfig& c, const Scoring& scoring,
                                     std::vector<std::pair<BackendKind, BackendRun<Dataset>>>& first_runs) {
   std::vector<TableRow> rows;
+  if constexpr (requires { data.ids; }) {
+    if (data.ids == io::LandmarkIds::absent && !c.association.method)
+      throw invalid_input_error(name + ": its landmarks have no ids: run it with --associate nn|jcbb");
+    if (data.ids == io::LandmarkIds::from_ground_truth)
+      std::printf("%s: the log has no landmark ids; each measurement took the id of its nearest true landmark, %s\n",
+                  name.c_str(), c.association.method ? "which scores the association" : "an oracle association");
+  }
   for (BackendKind kind : kinds) {
     if (left_out(kind, c, name)) continue;
     ProgressBar progress(name + ": " + backend_key(kind), data.steps.size());

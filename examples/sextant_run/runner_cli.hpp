@@ -38,7 +38,7 @@ inline void add_runner_options(CLI::App& app, CliOptions& options) {
   app.add_option("--out,-o", options.output.out, "directory for per-step CSV, TUM, .3Dscene files and summary.json");
   app.add_option("--associate", options.associate,
                  "known|nn|jcbb: use the data set's landmark ids, or withhold them and associate by nearest neighbour "
-                 "or JCBB (EKF and SEIF; overrides [association] method)");
+                 "or JCBB (EKF and SEIF; FastSLAM associates per particle; overrides [association] method)");
   app.add_option("--runs", options.runs, "Monte Carlo runs on the ship (overrides [ship] runs)")->check(CLI::Range(1, 100000));
   app.add_flag("--plots", options.output.plots, "also write PNG plots of trajectory, map, error and NEES (needs --out or "
                                                 "writes to ./sextant-run-output)");

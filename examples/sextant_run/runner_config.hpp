@@ -226,7 +226,7 @@ inline const std::vector<ConfigKey>& config_keys() {
        }},
       {"association", "method", "known",
        "known (the data set's ids) | nn (nearest neighbour) | jcbb (joint compatibility): ids withheld and found by "
-       "EKF and SEIF; the other back-ends need known ids",
+       "EKF and SEIF; FastSLAM associates per particle; GraphSLAM needs known ids",
        [](RunnerConfig& c, const std::string& v) {
          c.association.method = parse_choice<std::optional<AssociationMethod>>(
              v, {{"known", std::nullopt},

@@ -250,8 +250,9 @@ TEST_F(WrittenRawlog, BadLogsGiveOneLineErrorsNamingFileAndProblem) {
   EXPECT_NE(error_of(truncated).find(truncated + ": entry 3: truncated or malformed"), std::string::npos);
   EXPECT_EQ(read_rawlog_2d(whole).steps.size(), 2u);
 
-  const auto no_id = write("no_id.rawlog", false, action(0.5, 0.0, 0.1), frame(bearing({{-1, 2.0f}})));
-  EXPECT_NE(error_of(no_id).find("entry 1: a landmark without id"), std::string::npos);
+  const auto mixed = write("mixed.rawlog", false, action(0.5, 0.0, 0.1), frame(bearing({{4, 2.0f}})),
+                           action(0.5, 0.0, 0.1), frame(bearing({{-1, 2.0f}})));
+  EXPECT_NE(error_of(mixed).find("entry 3: some landmarks have ids and some have none"), std::string::npos);
 
   const auto nan = write("nan.rawlog", false, action(0.5, 0.0, 0.1), frame(bearing({{3, std::nanf("")}})));
   EXPECT_NE(error_of(nan).find("landmark 3: measurement contains NaN or Inf"), std::string::npos);
@@ -260,8 +261,44 @@ TEST_F(WrittenRawlog, BadLogsGiveOneLineErrorsNamingFileAndProblem) {
   EXPECT_NE(error_of(pitched).find("pitch != 0"), std::string::npos);
   EXPECT_EQ(detect_rawlog_kind(pitched), RawlogKind::spatial);
 
-  for (const auto& path : {missing, empty, garbage, truncated, no_id, nan, pitched})
+  for (const auto& path : {missing, empty, garbage, truncated, mixed, nan, pitched})
     EXPECT_EQ(error_of(path).find('\n'), std::string::npos) << path;
+}
+
+TEST_F(WrittenRawlog, LandmarksWithoutIdsTakeTheirIdsFromTheGroundTruth) {
+  // Two landmarks 1 m apart, seen from the origin and from 1 m further on: MRPT's landmarkID = -1.
+  auto obs = [](float range, float yaw) {
+    auto o = bearing({{-1, range}});
+    o->sensedData[0].yaw = yaw;
+    return o;
+  };
+  auto two = [&](float r1, float y1, float r2, float y2) {
+    auto o = obs(r1, y1);
+    o->sensedData.push_back(obs(r2, y2)->sensedData[0]);
+    return o;
+  };
+  const float far = static_cast<float>(std::hypot(3.0, 1.0)), near = static_cast<float>(std::hypot(2.0, 1.0));
+  const auto path = write("no_ids.rawlog", false, action(1.0, 0.0, 0.0), frame(two(3.0f, 0.0f, far, std::atan2(1.0f, 3.0f))),
+                          action(1.0, 0.0, 0.0), frame(obs(near, std::atan2(1.0f, 2.0f))));
+  auto data = read_rawlog_2d(path);
+  EXPECT_EQ(data.ids, io::LandmarkIds::absent);
+  ASSERT_EQ(data.steps.size(), 2u);
+  EXPECT_EQ(data.steps[0].observations[0].landmark_id, io::kNoLandmarkId);
+  const auto map = (dir / "map.txt").string(), robot_path = (dir / "path.txt").string();
+  std::ofstream(map) << "% x y z a b c id\n4 0 0 5 0 0 7\n4 1 0 5 0 0 9\n";
+  std::ofstream(robot_path) << "0 0 0 0 0 0\n1 0 0 0 0 0\n2 0 0 0 0 0\n";
+  const auto inferred = attach_ground_truth(data, {map, robot_path});
+  ASSERT_TRUE(inferred);
+  EXPECT_EQ(data.ids, io::LandmarkIds::from_ground_truth);
+  EXPECT_EQ(inferred->observations, 3u);
+  EXPECT_EQ(data.steps[0].observations[0].landmark_id, 7u);
+  EXPECT_EQ(data.steps[0].observations[1].landmark_id, 9u);
+  EXPECT_EQ(data.steps[1].observations[0].landmark_id, 9u);
+  EXPECT_LT(inferred->worst_nis, 1e-6);  // measurements written exactly (floats)
+  // A log with ids is left as it is.
+  const auto with_ids = write("ids.rawlog", false, action(1.0, 0.0, 0.0), frame(bearing({{7, 3.0f}})));
+  auto known = read_rawlog_2d(with_ids);
+  EXPECT_EQ(known.ids, io::LandmarkIds::measured);
 }
 
 // Fuzz findings 3 to 5 (docs/reliability.md): a corrupt length field makes MRPT's deserializer

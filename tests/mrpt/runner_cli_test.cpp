@@ -282,6 +282,20 @@ TEST_F(RunnerCli, WithheldIdsAreAssociatedAndScoredByTheFiltersOnly) {
   EXPECT_NE(bad.err.find("--associate: 'magic' is not one of known|nn|jcbb"), std::string::npos) << bad.err;
 }
 
+TEST_F(RunnerCli, RawlogWithoutIdsRunsEveryBackEndThatAssociates) {
+  SEXTANT_REQUIRE_MRPT_DEMO("kf-slam_6D_demo_DA.rawlog");
+  const auto r =
+      run_runner("-d " + sextant::testing::mrpt_demo("kf-slam_6D_demo_DA.rawlog") + " -b ekf,graph,fastslam2 --associate jcbb", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("the log has no landmark ids; each measurement took the id of its nearest true landmark, which "
+                       "scores the association"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("graph needs known ids, left out"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("association: precision"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("FastSLAM 2.0"), std::string::npos) << r.out;
+}
+
 TEST_F(RunnerCli, IsamTextWithoutGroundTruthIsTimedAndWrittenNotScored) {
   const auto data = (dir / "loop.txt").string();
   std::ofstream file(data);

@@ -1,9 +1,11 @@
 #pragma once
-// MRPT's own 2D EKF-SLAM (CRangeBearingKFSLAM2D) run over a rawlog as MRPT's kf-slam app runs it:
-// the peer that tests and benchmarks compare sextant's EkfSlam with, in the same process.
+// MRPT's own EKF-SLAM (CRangeBearingKFSLAM2D, CRangeBearingKFSLAM) run over a rawlog as MRPT's
+// kf-slam app runs it: the peer that tests and benchmarks compare sextant's EkfSlam with, in the same process.
 #include <Eigen/Core>
 #include <map>
 #include <mrpt/obs/CRawlog.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/slam/CRangeBearingKFSLAM.h>
 #include <mrpt/slam/CRangeBearingKFSLAM2D.h>
 #include <stdexcept>
 #include <string>
@@ -23,7 +25,9 @@ inline MrptActionFramePairs read_mrpt_pairs(const std::string& path) {
   MrptActionFramePairs out;
   mrpt::obs::CActionCollection::Ptr action;
   mrpt::obs::CSensoryFrame::Ptr frame;
-  for (std::size_t entry = 0; log.getActionObservationPair(action, frame, entry);) out.emplace_back(action, frame);
+  // A pair needs two entries: past the last one MRPT would print an "Index out of bounds" exception.
+  for (std::size_t entry = 0; entry + 1 < log.size() && log.getActionObservationPair(action, frame, entry);)
+    out.emplace_back(action, frame);
   return out;
 }
 
@@ -46,6 +50,25 @@ inline std::vector<std::pair<LandmarkId, Eigen::Vector2d>> run_mrpt_kf_slam_2d(c
   for (std::size_t i = 0; i < landmarks.size(); ++i)
     map.emplace_back(ids.at(static_cast<unsigned>(i)), Eigen::Vector2d(landmarks[i].x, landmarks[i].y));
   return map;
+}
+
+/// Runs CRangeBearingKFSLAM (6D robot, 3D landmarks) over the pairs with every option from an ini
+/// file, as kf-slam runs it (e.g. EKF-SLAM_6D_test_datassoc.ini: full EKF, JCBB); returns the final
+/// landmark positions.
+inline std::vector<Eigen::Vector3d> run_mrpt_kf_slam_3d(const MrptActionFramePairs& pairs, const std::string& ini) {
+  mrpt::slam::CRangeBearingKFSLAM filter;
+  filter.loadOptions(mrpt::config::CConfigFile(ini));
+  filter.setVerbosityLevel(mrpt::system::LVL_ERROR);
+  for (auto [action, frame] : pairs) filter.processActionObservation(action, frame);
+  mrpt::poses::CPose3DQuatPDFGaussian pose;
+  std::vector<mrpt::math::TPoint3D> landmarks;
+  std::map<unsigned int, mrpt::maps::CLandmark::TLandmarkID> ids;
+  mrpt::math::CVectorDouble full_state;
+  mrpt::math::CMatrixDouble full_cov;
+  filter.getCurrentState(pose, landmarks, ids, full_state, full_cov);
+  std::vector<Eigen::Vector3d> out;
+  for (const auto& p : landmarks) out.emplace_back(p.x, p.y, p.z);
+  return out;
 }
 
 /// Mean distance of a map's landmarks to the truth.

@@ -36,6 +36,7 @@
 #include "sextant/core/error.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/observation.hpp"
+#include "sextant/io/ids_from_ground_truth.hpp"
 #include "sextant/io/kf_slam_ground_truth.hpp"
 #include "sextant/io/landmark_dataset.hpp"
 #include "sextant/mrpt/exception_text.hpp"
@@ -140,6 +141,8 @@ class RawlogParser {
   }
 
   const SensorDescription& sensor() const { return sensor_; }
+  /// Whether the landmarks carry ids (false: MRPT's landmarkID = -1 throughout).
+  bool has_ids() const { return ids_.value_or(true); }
 
  private:
   [[noreturn]] void fail(const std::string& problem) const {
@@ -203,15 +206,23 @@ class RawlogParser {
     std::set<LandmarkId> seen;
     for (const auto& s : step.sightings) seen.insert(s.id);
     for (const auto& m : bearing.sensedData) {
-      if (m.landmarkID < 0)
-        fail("a landmark without id (landmarkID = -1): the reader needs known data association");
+      const bool with_id = m.landmarkID >= 0;
+      note_id_kind(with_id);
+      const std::string which = with_id ? "landmark " + std::to_string(m.landmarkID) : "a landmark without id";
       const Eigen::Vector3d z(m.range, m.yaw, m.pitch);
-      if (!z.allFinite()) fail("landmark " + std::to_string(m.landmarkID) + ": measurement contains NaN or Inf");
-      if (!(z(0) > 0.0)) fail("landmark " + std::to_string(m.landmarkID) + ": range must be positive");
-      if (!seen.insert(static_cast<LandmarkId>(m.landmarkID)).second)
-        fail("landmark " + std::to_string(m.landmarkID) + " measured twice in one frame");
-      step.sightings.push_back({static_cast<LandmarkId>(m.landmarkID), z});
+      if (!z.allFinite()) fail(which + ": measurement contains NaN or Inf");
+      if (!(z(0) > 0.0)) fail(which + ": range must be positive");
+      const LandmarkId id = with_id ? static_cast<LandmarkId>(m.landmarkID) : io::kNoLandmarkId;
+      if (with_id && !seen.insert(id).second) fail(which + " measured twice in one frame");
+      step.sightings.push_back({id, z});
     }
+  }
+
+  /// A log gives every landmark an id (landmarkID >= 0) or none (-1, MRPT's "unknown"), not both.
+  void note_id_kind(bool with_id) {
+    if (!ids_) ids_ = with_id;
+    else if (*ids_ != with_id)
+      fail("some landmarks have ids and some have none (landmarkID = -1): a log must be one or the other");
   }
 
   void describe_sensor(const ::mrpt::obs::CObservationBearingRange& bearing) {
@@ -236,6 +247,7 @@ class RawlogParser {
   std::optional<RawStep> pending_;
   std::optional<::mrpt::poses::CPose2D> last_odometry_;
   SensorDescription sensor_;
+  std::optional<bool> ids_;  ///< whether the landmarks seen so far had ids
 };
 
 /// The noise standard deviation to use: the override if given, else the rawlog's (which must be > 0).
@@ -246,6 +258,10 @@ inline double noise_std(const std::optional<double>& override_value, double from
     throw parse_error(path + ": sensor " + name + " noise is " + std::to_string(value) +
                       (override_value ? " (from the options)" : " in the rawlog; give it in the options"));
   return value;
+}
+
+inline io::LandmarkIds ids_of(const RawlogParser& parser) {
+  return parser.has_ids() ? io::LandmarkIds::measured : io::LandmarkIds::absent;
 }
 
 inline double step_dt(const std::vector<RawStep>& steps, std::size_t k) {
@@ -271,9 +287,10 @@ inline bool is_spatial(const std::vector<RawStep>& steps, const SensorDescriptio
 /// The parsed log as planar steps: (x, y, heading) odometry (3D odometry projected onto the
 /// plane), range and bearing; a nonzero pitch is an error.
 inline RawlogDataset2D to_planar(const std::string& path, const std::vector<RawStep>& raw, const SensorDescription& sensor,
-                                 const RawlogOptions& options) {
+                                 io::LandmarkIds ids, const RawlogOptions& options) {
   RawlogDataset2D out;
   out.path = path;
+  out.ids = ids;
   out.sensor.sensor_pose << sensor.mount(0), sensor.mount(1), sensor.mount(3);
   const double sr = noise_std(options.std_range, sensor.std_range_yaw_pitch(0), path, "range");
   const double sy = noise_std(options.std_yaw, sensor.std_range_yaw_pitch(1), path, "yaw");
@@ -301,9 +318,10 @@ inline RawlogDataset2D to_planar(const std::string& path, const std::vector<RawS
 
 /// The parsed log as spatial steps: 6D odometry, range, yaw and pitch; 2D odometry is an error.
 inline RawlogDataset3D to_spatial(const std::string& path, const std::vector<RawStep>& raw,
-                                  const SensorDescription& sensor, const RawlogOptions& options) {
+                                  const SensorDescription& sensor, io::LandmarkIds ids, const RawlogOptions& options) {
   RawlogDataset3D out;
   out.path = path;
+  out.ids = ids;
   out.sensor.sensor_pose = sensor.mount;
   const double sr = noise_std(options.std_range, sensor.std_range_yaw_pitch(0), path, "range");
   const double sy = noise_std(options.std_yaw, sensor.std_range_yaw_pitch(1), path, "yaw");
@@ -338,14 +356,14 @@ inline RawlogKind detect_rawlog_kind(const std::string& path, const RawlogOption
 inline RawlogDataset2D read_rawlog_2d(const std::string& path, const RawlogOptions& options = {}) {
   detail::RawlogParser parser(path);
   const auto raw = parser.parse(options);
-  return detail::to_planar(path, raw, parser.sensor(), options);
+  return detail::to_planar(path, raw, parser.sensor(), detail::ids_of(parser), options);
 }
 
 /// Reads a spatial rawlog: 6D robot, 6D odometry, range, yaw and pitch. 2D odometry is an error.
 inline RawlogDataset3D read_rawlog_3d(const std::string& path, const RawlogOptions& options = {}) {
   detail::RawlogParser parser(path);
   const auto raw = parser.parse(options);
-  return detail::to_spatial(path, raw, parser.sensor(), options);
+  return detail::to_spatial(path, raw, parser.sensor(), detail::ids_of(parser), options);
 }
 
 /// Reads a rawlog once as whichever it is, planar or spatial (see detect_rawlog_kind).
@@ -353,8 +371,8 @@ inline std::variant<RawlogDataset2D, RawlogDataset3D> read_rawlog(const std::str
                                                                   const RawlogOptions& options = {}) {
   detail::RawlogParser parser(path);
   const auto raw = parser.parse(options);
-  if (detail::is_spatial(raw, parser.sensor())) return detail::to_spatial(path, raw, parser.sensor(), options);
-  return detail::to_planar(path, raw, parser.sensor(), options);
+  if (detail::is_spatial(raw, parser.sensor())) return detail::to_spatial(path, raw, parser.sensor(), detail::ids_of(parser), options);
+  return detail::to_planar(path, raw, parser.sensor(), detail::ids_of(parser), options);
 }
 
 /// The ground-truth files MRPT ships beside a demo rawlog: `<stem>_ground_truth.txt` (map) and
@@ -372,9 +390,10 @@ inline std::optional<GroundTruthFiles> find_ground_truth(const std::string& rawl
 
 /// Attaches ground truth: path row k is the pose after step k (row 0 the start); the path must
 /// cover every step and start where the rawlog does (the origin), and the map must hold every
-/// observed landmark.
+/// observed landmark. A log without landmark ids gets them from the truth
+/// (io/ids_from_ground_truth.hpp), with how clear-cut they were.
 template <class Dataset>
-void attach_ground_truth(Dataset& data, const GroundTruthFiles& files) {
+std::optional<io::InferredIds> attach_ground_truth(Dataset& data, const GroundTruthFiles& files) {
   constexpr int D = Dataset::Sensor::Landmark::RowsAtCompileTime;
   const auto path = io::read_kf_slam_path(files.path);
   if (path.size() < data.steps.size() + 1)
@@ -388,10 +407,12 @@ void attach_ground_truth(Dataset& data, const GroundTruthFiles& files) {
       data.true_poses.push_back(path[k]);
   }
   data.true_landmarks = io::read_kf_slam_landmarks<D>(files.map);
+  if (data.ids == io::LandmarkIds::absent) return io::infer_ids_from_ground_truth(data);
   for (const auto& step : data.steps)
     for (const auto& o : step.observations)
       if (!data.true_landmarks.count(o.landmark_id))
         throw parse_error(files.map + ": no ground truth for observed landmark " + std::to_string(o.landmark_id));
+  return std::nullopt;
 }
 
 }  // namespace sextant::mrpt_io
