@@ -10,7 +10,7 @@
 #include <numbers>
 
 #include "mrpt/mrpt_demo_data.hpp"
-#include "support/bounded_new.hpp"  // this binary's operator new throws above 256 MiB (see the corrupt-length tests)
+#include "support/bounded_mrpt_alloc.hpp"  // new and MRPT's aligned_malloc throw above 256 MiB (corrupt-length tests)
 #include "support/nees_bound.hpp"
 #include "support/temp_path.hpp"
 #ifdef SEXTANT_HAS_MRPT_SLAM
@@ -303,7 +303,8 @@ TEST_F(WrittenRawlog, LandmarksWithoutIdsTakeTheirIdsFromTheGroundTruth) {
 
 // Fuzz findings 3 to 5 (docs/reliability.md): a corrupt length field makes MRPT's deserializer
 // ask for gigabytes. This binary's operator new throws std::bad_alloc above 256 MiB
-// (support/bounded_new.hpp), as new does on a machine without that memory, so the test never asks
+// (support/bounded_mrpt_alloc.hpp: so does MRPT's aligned_malloc), as they do on a machine without
+// that memory, so the test never asks
 // the system for it; the reader must turn it into a one-line parse_error.
 class CorruptLengthField : public WrittenRawlog {
  protected:
@@ -355,6 +356,18 @@ TEST_F(CorruptLengthField, StringLengthIsAMalformedLogNotACrash) {
   observation->sensorLabel = label;
   expect_malformed_entry_1(error_after_corrupting(static_cast<std::uint32_t>(label.size()), 1061109568u,
                                                   action(0.5, 0.0, 0.1), frame(observation)));
+}
+
+TEST_F(CorruptLengthField, VelocityCountOfASpatialActionIsAMalformedLogNotACrash) {
+  // Finding 6 (CI 2026-11-23): CActionRobotMovement3D's velocities (a CVectorFloat, allocated
+  // through mrpt::aligned_malloc, not new) resized to a corrupt length: 15.9 GB asked of aligned_alloc.
+  constexpr std::uint32_t kVelocities = 2827;
+  ::mrpt::obs::CActionRobotMovement3D move;
+  move.velocities.resize(kVelocities);
+  move.velocities.fill(0.0f);
+  auto actions = ::mrpt::obs::CActionCollection::Create();
+  actions->insert(move);
+  expect_malformed_entry_1(error_after_corrupting(kVelocities, 0x7fffffff, frame(bearing({{1, 2.0f}})), actions));
 }
 
 TEST_F(WrittenRawlog, GroundTruthMustCoverEveryStepAndLandmark) {

@@ -88,7 +88,7 @@ void GraphSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   const Eigen::Matrix<double, X, X> newest_cov =
       symmetrized(prediction.J_x_x * newest_cov_ * prediction.J_x_x.transpose() + prediction.R);
   if (!newest_cov.allFinite()) throw numerical_error("GraphSLAM: covariance of the new pose overflowed");
-  require_factorizable_extension(prior_.cov, prediction.J_x_x, prediction.R, "GraphSLAM: the new pose");
+  require_factorizable_extension<X>(prior_.cov, prediction.J_x_x, prediction.R, "GraphSLAM: the new pose");
   motions_.push_back({u, dt});
   poses_.push_back(prediction.x);
   newest_cov_ = newest_cov;
@@ -110,9 +110,9 @@ UpdateResult GraphSlam<Motion, Sensor>::update(std::span<const ObservationType> 
   for (const auto& observation : fresh) {
     inits.push_back(initialize_landmark(sensor_, poses_[pose], observation.z, observation.landmark_id));
     linearize_observation(sensor_, poses_[pose], inits.back().m, observation.z, observation.landmark_id, 0);
-    require_factorizable_extension(prior_.cov, inits.back().J_m_x,
-                                   symmetrized(inits.back().J_m_z * inits.back().Q * inits.back().J_m_z.transpose()),
-                                   "GraphSLAM: new landmark " + std::to_string(observation.landmark_id));
+    require_factorizable_extension<M>(prior_.cov, inits.back().J_m_x,
+                                      symmetrized(inits.back().J_m_z * inits.back().Q * inits.back().J_m_z.transpose()),
+                                      "GraphSLAM: new landmark " + std::to_string(observation.landmark_id));
   }
   for (const auto& observation : known) measurements_[pool_.slot(observation.landmark_id)].push_back({pose, observation.z});
   for (std::size_t i = 0; i < fresh.size(); ++i) {
