@@ -1,6 +1,6 @@
 #pragma once
-/// \file Rotations as 3x3 matrices: hat and vee, the exponential and logarithm maps, and the
-/// inverse of the right Jacobian (d log(R Exp(d)) / d d at d = 0 is J_r^-1(log R)).
+/// \file Rotations as 3x3 matrices: hat and vee, the exponential and logarithm maps, the inverse
+/// of the right Jacobian (d log(R Exp(d)) / d d at d = 0 is J_r^-1(log R)) and the left Jacobian.
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -47,5 +47,19 @@ inline Eigen::Matrix3d right_jacobian_inverse(const Eigen::Vector3d& w) {
                                  : 1.0 / (theta * theta) - (1.0 + std::cos(theta)) / (2.0 * theta * std::sin(theta));
   return Eigen::Matrix3d::Identity() + 0.5 * W + c * W * W;
 }
+
+/// J_l(w) = I + (1 - cos theta) / theta^2 W + (theta - sin theta) / theta^3 W^2:
+/// Exp(w + d) ~ Exp(J_l(w) d) Exp(w). J_r(w) = J_l(-w).
+inline Eigen::Matrix3d left_jacobian(const Eigen::Vector3d& w) {
+  const double theta = w.norm(), t2 = theta * theta, t4 = t2 * t2;
+  const Eigen::Matrix3d W = hat(w);
+  const bool series = theta < 1e-2;  // the closed forms cancel for small angles
+  const double a = series ? 0.5 - t2 / 24.0 + t4 / 720.0 : (1.0 - std::cos(theta)) / t2;
+  const double b = series ? 1.0 / 6.0 - t2 / 120.0 + t4 / 5040.0 : (theta - std::sin(theta)) / (t2 * theta);
+  return Eigen::Matrix3d::Identity() + a * W + b * W * W;
+}
+
+/// J_l(w)^-1 = J_r(-w)^-1.
+inline Eigen::Matrix3d left_jacobian_inverse(const Eigen::Vector3d& w) { return right_jacobian_inverse(-w); }
 
 }  // namespace sextant::so3

@@ -1,0 +1,152 @@
+#pragma once
+/// \file Visual-inertial models on SE(3), after seed 004: an IMU pose driven by measured linear and
+/// angular velocity (eqs. 13, 37-38), and a rectified stereo camera that measures a 3D point as its
+/// pixel pair (uL, vL, uR, vR) = M pi(cam_T_imu T^-1 m) (eqs. 7, 24-26, 31, 41). The pose is
+/// world_T_imu, perturbed on the right (core/se3_space.hpp); the seed's inverse pose U = T^-1
+/// with a left perturbation is the same model with the tangent's sign flipped.
+/// Derivations: docs/derivations/stereo_imu_se3.md.
+
+#include <Eigen/Core>
+#include <string>
+
+#include "sextant/core/error.hpp"
+#include "sextant/core/model_results.hpp"
+#include "sextant/core/se3.hpp"
+#include "sextant/core/se3_space.hpp"
+
+namespace sextant {
+
+/// T' = T exp(tau u^), u = (v, omega) in the IMU frame (eq. 13 for T = U^-1). With the velocity
+/// noise w ~ N(0, W) held over the step, T' = T exp(tau (u + w)^) and, to first order,
+/// d' = Ad(exp(-tau u^)) d + tau J_r(tau u) w: G = Ad(exp(-tau u^)) (eq. 38's exp(-tau u^) in
+/// adjoint form), R = tau^2 J_r W J_r^T.
+struct ImuVelocitySe3 {
+  using State = Eigen::Matrix4d;
+  using Control = se3::Vector6d;  ///< (v [m/s], omega [rad/s]) in the IMU frame
+  using Space = Se3Space;
+  static constexpr int kDim = 6;
+
+  se3::Matrix6d W = se3::Matrix6d::Identity();  ///< covariance of the velocity noise (per sample)
+
+  MotionPrediction<State, 6> predict(const State& x, const Control& u, double dt) const {
+    const se3::Vector6d step = dt * u;
+    const Eigen::Matrix4d increment = se3::exp(step);
+    const se3::Matrix6d Jr = se3::right_jacobian(step);
+    MotionPrediction<State, 6> out;
+    out.x = se3::normalized(x * increment);
+    out.J_x_x = se3::adjoint(se3::inverse(increment));
+    out.R = dt * dt * Jr * W * Jr.transpose();
+    out.R = (0.5 * (out.R + out.R.transpose())).eval();
+    return out;
+  }
+
+  /// r = log(exp(tau u^)^-1 T_from^-1 T_to): zero when T_to = predict(T_from, u); J_to = J_r^-1(r),
+  /// J_from = -J_r^-1(r) Ad(T_to^-1 T_from); cov = tau^2 J_r W J_r^T at the control.
+  BetweenFactor<6> between(const State& from, const State& to, const Control& u, double dt) const {
+    const se3::Vector6d step = dt * u;
+    const Eigen::Matrix4d relative = se3::inverse(from) * to;
+    const se3::Matrix6d Jr = se3::right_jacobian(step);
+    BetweenFactor<6> out;
+    out.r = se3::log(se3::inverse(se3::exp(step)) * relative);
+    const se3::Matrix6d Jr_inv = se3::right_jacobian_inverse(out.r);
+    out.J_to = Jr_inv;
+    out.J_from = -Jr_inv * se3::adjoint(se3::inverse(relative));
+    out.cov = dt * dt * Jr * W * Jr.transpose();
+    out.cov = (0.5 * (out.cov + out.cov.transpose())).eval();
+    return out;
+  }
+};
+
+/// Intrinsics of a rectified stereo pair: both cameras share K, the right one sits `baseline`
+/// metres along the left camera's x axis.
+struct StereoCalibration {
+  double fx = 1.0, fy = 1.0, cx = 0.0, cy = 0.0;
+  double baseline = 1.0;  ///< [m]
+
+  /// The seed's M (eq. 7): (uL, vL, uR, vR) = M (x, y, z, 1) / z for a point in the left camera.
+  Eigen::Matrix4d stereo_matrix() const {
+    Eigen::Matrix4d M;
+    M << fx, 0, cx, 0,  //
+        0, fy, cy, 0,   //
+        fx, 0, cx, -fx * baseline, 0, fy, cy, 0;
+    return M;
+  }
+};
+
+/// z = (uL, vL, uR, vR) = M pi(cam_T_imu T^-1 m), pi(q) = q / q_3 (eqs. 24-25), pixel noise
+/// sigma on each coordinate. A point at or behind the camera (depth <= min_depth) cannot be
+/// predicted; a pixel pair with disparity uL - uR <= 0 cannot be triangulated: both throw
+/// numerical_error naming the problem, never a NaN.
+struct StereoPixelsSe3 {
+  using Landmark = Eigen::Vector3d;
+  using Measurement = Eigen::Vector4d;
+
+  StereoCalibration calibration;
+  Eigen::Matrix4d cam_T_imu = Eigen::Matrix4d::Identity();  ///< maps IMU-frame points into the left camera
+  double pixel_sigma = 1.0;                                 ///< [px], each of uL, vL, uR, vR
+  double min_depth = 1e-3;                                  ///< [m] in front of the left camera
+
+  /// H_m = M dpi/dq(q) cam_T_imu T^-1 P^T (eq. 31), H_x = -M dpi/dq(q) cam_T_imu (T^-1 m)^odot
+  /// (eq. 41 with the sign of the right perturbation).
+  MeasurementPrediction<4, 6, 3> predict(const Eigen::Matrix4d& x, const Landmark& m) const {
+    const Eigen::Vector4d s = se3::inverse(x) * m.homogeneous();  // the point in the IMU frame
+    const Eigen::Vector4d q = cam_T_imu * s;
+    if (!(q(2) > min_depth))
+      throw numerical_error("stereo camera: the landmark is at or behind the camera (depth " + std::to_string(q(2)) +
+                            " m)");
+    const Eigen::Matrix4d M = calibration.stereo_matrix();
+    const Eigen::Matrix4d M_dpi = M * projection_jacobian(q);
+    MeasurementPrediction<4, 6, 3> out;
+    out.z = M * (q / q(2));
+    out.J_z_m = M_dpi * (cam_T_imu * se3::inverse(x)).leftCols<3>();
+    out.J_z_x = -M_dpi * cam_T_imu * se3::odot(s);
+    out.Q = pixel_sigma * pixel_sigma * Eigen::Matrix4d::Identity();
+    return out;
+  }
+
+  Measurement residual(const Measurement& z, const Measurement& z_hat) const { return z - z_hat; }
+
+  /// Stereo triangulation: depth fx b / (uL - uR), the row from the mean of vL and vR; then into
+  /// the world through T imu_T_cam. J_m_z and J_m_x give the landmark's covariance.
+  LandmarkInit<3, 6, 4> initialize(const Eigen::Matrix4d& x, const Measurement& z) const {
+    const auto& c = calibration;
+    const double disparity = z(0) - z(2);
+    if (!(disparity > 0.0))
+      throw numerical_error("stereo camera: disparity uL - uR = " + std::to_string(disparity) +
+                            " px, not positive: the point cannot be triangulated");
+    const double depth = c.fx * c.baseline / disparity;
+    const double v = 0.5 * (z(1) + z(3));
+    const Eigen::Vector3d q((z(0) - c.cx) * depth / c.fx, (v - c.cy) * depth / c.fy, depth);
+    // dq/dz: depth depends on uL and uR through the disparity.
+    const double dd_dd = -depth / disparity;  // d depth / d disparity
+    Eigen::Matrix<double, 3, 4> dq_dz = Eigen::Matrix<double, 3, 4>::Zero();
+    dq_dz(0, 0) = depth / c.fx + (z(0) - c.cx) / c.fx * dd_dd;
+    dq_dz(0, 2) = -(z(0) - c.cx) / c.fx * dd_dd;
+    dq_dz(1, 0) = (v - c.cy) / c.fy * dd_dd;
+    dq_dz(1, 2) = -dq_dz(1, 0);
+    dq_dz(1, 1) = dq_dz(1, 3) = 0.5 * depth / c.fy;
+    dq_dz(2, 0) = dd_dd;
+    dq_dz(2, 2) = -dd_dd;
+    const Eigen::Matrix4d imu_T_cam = se3::inverse(cam_T_imu);
+    const Eigen::Vector4d s = imu_T_cam * q.homogeneous();  // the point in the IMU frame
+    const Eigen::Matrix4d world_T_cam = x * imu_T_cam;
+    LandmarkInit<3, 6, 4> out;
+    out.m = (x * s).head<3>();
+    out.J_m_z = world_T_cam.topLeftCorner<3, 3>() * dq_dz;
+    out.J_m_x = (x * se3::odot(s)).topRows<3>();  // T exp(d^) s ~ T s + T s^odot d
+    out.Q = pixel_sigma * pixel_sigma * Eigen::Matrix4d::Identity();
+    return out;
+  }
+
+  /// dpi/dq for pi(q) = q / q_3 (eq. 26).
+  static Eigen::Matrix4d projection_jacobian(const Eigen::Vector4d& q) {
+    Eigen::Matrix4d J = Eigen::Matrix4d::Zero();
+    J(0, 0) = J(1, 1) = J(3, 3) = 1.0;
+    J(0, 2) = -q(0) / q(2);
+    J(1, 2) = -q(1) / q(2);
+    J(3, 2) = -q(3) / q(2);
+    return J / q(2);
+  }
+};
+
+}  // namespace sextant

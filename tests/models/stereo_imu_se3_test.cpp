@@ -1,0 +1,136 @@
+#include "sextant/models/stereo_imu_se3.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "sextant/core/concepts.hpp"
+#include "sextant/testing/model_checks.hpp"
+
+namespace sextant {
+namespace {
+
+using se3::Vector6d;
+
+/// KITTI-like rectified stereo: 0.54 m baseline, 718 px focal length, IMU x forward, y left, z up,
+/// camera z forward, x right, y down, mounted 1 m forward and 0.5 m up.
+StereoPixelsSe3 kitti_like_camera() {
+  StereoPixelsSe3 camera;
+  camera.calibration = {.fx = 718.9, .fy = 718.9, .cx = 607.2, .cy = 185.2, .baseline = 0.54};
+  Eigen::Matrix3d R_cam_imu;  // rows: camera axes in IMU coordinates
+  R_cam_imu << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  camera.cam_T_imu = se3::inverse(se3::make(R_cam_imu.transpose(), Eigen::Vector3d(1.0, 0.0, 0.5)));
+  camera.pixel_sigma = 1.5;
+  return camera;
+}
+
+struct RandomScene {
+  std::mt19937_64 rng;
+  std::normal_distribution<double> n{0.0, 1.0};
+  explicit RandomScene(std::uint64_t seed) : rng(seed) {}
+  Vector6d tangent(double scale_t, double scale_r) {
+    Vector6d xi;
+    xi << scale_t * n(rng), scale_t * n(rng), scale_t * n(rng), scale_r * n(rng), scale_r * n(rng), scale_r * n(rng);
+    return xi;
+  }
+  Eigen::Matrix4d pose() { return se3::exp(tangent(20.0, 1.0)); }
+  /// A point 3-40 m ahead of the camera of `camera` at pose T, within +-0.5 of the optical axis.
+  Eigen::Vector3d landmark_in_view(const Eigen::Matrix4d& T, const StereoPixelsSe3& camera) {
+    std::uniform_real_distribution<double> depth(3.0, 40.0), lateral(-0.5, 0.5);
+    const double d = depth(rng);
+    const Eigen::Vector4d q(lateral(rng) * d, lateral(rng) * d, d, 1.0);
+    return (T * se3::inverse(camera.cam_T_imu) * q).head<3>();
+  }
+};
+
+TEST(StereoImuSe3, ModelsFitTheConcepts) {
+  static_assert(MotionModel<ImuVelocitySe3>);
+  static_assert(HasBetweenFactor<ImuVelocitySe3>);
+  static_assert(MeasurementModelFor<StereoPixelsSe3, ImuVelocitySe3>);
+}
+
+TEST(StereoImuSe3, MotionJacobiansMatchCentralDifferencesAtRandomStates) {
+  RandomScene scene(1);
+  ImuVelocitySe3 imu;
+  imu.W.diagonal() << 0.25, 0.25, 0.25, 0.0025, 0.0025, 0.0025;
+  for (int i = 0; i < 50; ++i) {
+    const Eigen::Matrix4d T = scene.pose();
+    const Vector6d u = scene.tangent(5.0, 0.3);
+    const double dt = 0.1 * (1 + i % 3);
+    EXPECT_TRUE(testing::check_motion_jacobians(imu, T, u, dt)) << testing::check_motion_jacobians(imu, T, u, dt).report;
+    const Eigen::Matrix4d to = Se3Space::plus(imu.predict(T, u, dt).x, scene.tangent(0.3, 0.05));
+    const auto between = testing::check_between_jacobians(imu, T, to, u, dt);
+    EXPECT_TRUE(between) << between.report;
+  }
+}
+
+TEST(StereoImuSe3, ProcessNoiseIsTheVelocityNoisePropagatedThroughTheMotion) {
+  // R = V W V^T with V = d minus(T exp(dt (u + w)^), T exp(dt u^)) / dw, V by central differences.
+  RandomScene scene(2);
+  ImuVelocitySe3 imu;
+  imu.W.diagonal() << 0.25, 0.16, 0.09, 0.0025, 0.0016, 0.0036;
+  for (int i = 0; i < 20; ++i) {
+    const Eigen::Matrix4d T = scene.pose();
+    const Vector6d u = scene.tangent(5.0, 0.5);
+    const double dt = 0.1;
+    const Eigen::Matrix4d mean = T * se3::exp(dt * u);
+    se3::Matrix6d V;
+    for (int k = 0; k < 6; ++k) {
+      Vector6d h = Vector6d::Zero();
+      h(k) = 1e-6;
+      V.col(k) = (Se3Space::minus(T * se3::exp(dt * (u + h)), mean) - Se3Space::minus(T * se3::exp(dt * (u - h)), mean)) / 2e-6;
+    }
+    EXPECT_TRUE(imu.predict(T, u, dt).R.isApprox(V * imu.W * V.transpose(), 1e-6));
+  }
+}
+
+TEST(StereoImuSe3, MeasurementJacobiansAndTriangulationMatchAtRandomStates) {
+  RandomScene scene(3);
+  const auto camera = kitti_like_camera();
+  for (int i = 0; i < 100; ++i) {
+    const Eigen::Matrix4d T = scene.pose();
+    const Eigen::Vector3d m = scene.landmark_in_view(T, camera);
+    const auto check = testing::check_measurement_jacobians<ImuVelocitySe3>(camera, T, m);
+    EXPECT_TRUE(check) << check.report;
+  }
+}
+
+TEST(StereoImuSe3, PixelsAreThePinholeProjectionInBothCameras) {
+  // Seed eq. 7 by hand: uL = fx x/z + cx, vL = vR = fy y/z + cy, uR = fx (x - b)/z + cx.
+  auto camera = kitti_like_camera();
+  camera.cam_T_imu.setIdentity();
+  const Eigen::Vector3d p(2.0, -1.0, 10.0);
+  const auto z = camera.predict(Eigen::Matrix4d::Identity(), p).z;
+  const auto& c = camera.calibration;
+  EXPECT_NEAR(z(0), c.fx * 0.2 + c.cx, 1e-12);
+  EXPECT_NEAR(z(1), c.fy * -0.1 + c.cy, 1e-12);
+  EXPECT_NEAR(z(2), c.fx * (2.0 - c.baseline) / 10.0 + c.cx, 1e-12);
+  EXPECT_EQ(z(3), z(1));
+  EXPECT_NEAR(z(0) - z(2), c.fx * c.baseline / 10.0, 1e-12);  // disparity
+}
+
+TEST(StereoImuSe3, PointsBehindTheCameraAndNonPositiveDisparitiesAreErrorsNotNaN) {
+  const auto camera = kitti_like_camera();
+  const Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  // The camera looks along the IMU's +x: a point at x = -5 is behind it, one at x = 1 (the
+  // camera's own position) has depth 0.
+  for (const Eigen::Vector3d& m : {Eigen::Vector3d(-5.0, 0.0, 0.5), Eigen::Vector3d(1.0, 0.0, 0.5)}) {
+    try {
+      (void)camera.predict(T, m);
+      ADD_FAILURE() << "a point at depth <= 0 was predicted";
+    } catch (const numerical_error& e) {
+      EXPECT_NE(std::string(e.what()).find("behind the camera"), std::string::npos) << e.what();
+    }
+  }
+  for (const double uR : {600.0, 610.0}) {  // disparity 0 and -10 px
+    try {
+      (void)camera.initialize(T, Eigen::Vector4d(600.0, 180.0, uR, 180.0));
+      ADD_FAILURE() << "disparity " << 600.0 - uR << " was triangulated";
+    } catch (const numerical_error& e) {
+      EXPECT_NE(std::string(e.what()).find("disparity"), std::string::npos) << e.what();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sextant
