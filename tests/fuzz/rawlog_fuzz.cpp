@@ -6,11 +6,6 @@
 #include "sextant/core/error.hpp"
 #include "sextant/mrpt/rawlog.hpp"
 
-/// What MRPT asks of malloc itself (Eigen matrices inside its classes) is bounded by ASan: above
-/// 256 MiB malloc returns null, which Eigen turns into std::bad_alloc, instead of libFuzzer
-/// reporting the request as an out-of-memory crash (the bounds of support/bounded_new.hpp).
-extern "C" const char* __asan_default_options() { return "allocator_may_return_null=1:max_allocation_size_mb=256"; }
-
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static sextant::fuzz::InputFile file(".rawlog");
   const std::string& path = file.write(data, size);

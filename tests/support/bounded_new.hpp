@@ -18,6 +18,14 @@
 #include <cstdlib>
 #include <new>
 
+/// What a library asks of malloc itself (Eigen matrices inside MRPT's classes, libzip's buffers)
+/// is bounded by ASan where it runs: above 256 MiB malloc returns null, which Eigen turns into
+/// std::bad_alloc and libzip into an error, instead of libFuzzer reporting the request as an
+/// out-of-memory crash. Without ASan this function is never called.
+extern "C" __attribute__((used)) const char* __asan_default_options() {
+  return "allocator_may_return_null=1:max_allocation_size_mb=256";
+}
+
 namespace sextant::fuzz {
 inline constexpr std::size_t kBoundedNewLimit = std::size_t{1} << 28;  // 256 MiB in one request
 /// ... and 512 MiB alive at once: MRPT also trusts counts it feeds to containers that allocate in

@@ -1,0 +1,161 @@
+#pragma once
+/// \file Visual-inertial data in the format of seed 004 (UCSD ECE276A, KITTI-derived): a .npz with
+/// `time_stamps` (1, T) [s], `linear_velocity` and `angular_velocity` or `rotational_velocity`
+/// (3, T) in the IMU frame, `features` (4, M, T) = (uL, vL, uR, vR) pixels of landmark m in frame t,
+/// -1 where unseen, `K` (3, 3), `b` (the baseline [m]) and the extrinsic as `imu_T_cam` or
+/// `cam_T_imu` (4, 4). Each frame k > 0 becomes one step: the velocity sampled at frame k - 1, held
+/// over dt = t_k - t_(k-1), then the stereo observations of frame k; frame 0's observations come
+/// before any motion.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "sextant/core/error.hpp"
+#include "sextant/core/observation.hpp"
+#include "sextant/core/se3.hpp"
+#include "sextant/io/npz_reader.hpp"
+#include "sextant/models/stereo_imu_se3.hpp"
+
+namespace sextant::io {
+
+struct VisualInertialNpzOptions {
+  /// How to read the translation of a `cam_T_imu` key. The files of seed 004's course that use that
+  /// key (0027_clean/noisy.npz) store the rotation IMU -> camera axes but the camera's position
+  /// in the IMU frame as translation (docs/results/vislam.md: reprojection against both
+  /// readings, and KITTI's mounting); true reads it that way, false as a proper cam_T_imu.
+  bool cam_T_imu_translation_is_camera_position = true;
+};
+
+struct VisualInertialDataset {
+  std::string path;
+  std::vector<double> time_stamps;                             ///< T frame times [s]
+  std::vector<Observation<Eigen::Vector4d>> first_observations;  ///< frame 0, before any motion
+  std::vector<Step<se3::Vector6d, Eigen::Vector4d>> steps;     ///< T - 1: step k ends at frame k + 1
+  StereoCalibration calibration;
+  Eigen::Matrix4d cam_T_imu = Eigen::Matrix4d::Identity();  ///< proper: maps IMU-frame points to the camera
+  std::string extrinsic_key;                               ///< "imu_T_cam" or "cam_T_imu"
+  std::size_t landmark_count = 0;                          ///< M: ids are 0 .. M - 1
+  std::size_t observation_count = 0;
+  std::size_t incomplete_observations = 0;  ///< some but not all four pixels -1: dropped, counted
+};
+
+namespace detail {
+
+inline const NpyArray& require_shape(const NpyArray& a, const std::vector<std::size_t>& shape, const std::string& what) {
+  if (a.shape != shape) {
+    std::string have = "(", want = "(";
+    for (const auto d : a.shape) have += std::to_string(d) + ",";
+    for (const auto d : shape) want += std::to_string(d) + ",";
+    throw parse_error(what + ": shape " + have + ") where " + want + ") was expected");
+  }
+  for (const double v : a.values)
+    if (!std::isfinite(v)) throw parse_error(what + ": holds a NaN or infinite value");
+  return a;
+}
+
+inline Eigen::Matrix4d read_rigid_transform(const NpzFile& file, const std::string& key) {
+  const std::string what = file.path() + ": key '" + key + "'";
+  const auto a = file.array(key);
+  require_shape(a, {4, 4}, what);
+  Eigen::Matrix4d T;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) T(r, c) = a.values[4 * r + c];
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  if (!(R.transpose() * R).isIdentity(1e-3) || R.determinant() < 0.0 ||
+      !T.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1)))
+    throw parse_error(what + ": not a rigid transform (rotation not orthonormal or last row not 0 0 0 1)");
+  return se3::make(Eigen::Quaterniond(R).normalized().toRotationMatrix(), T.topRightCorner<3, 1>());
+}
+
+/// The extrinsic as a proper cam_T_imu, from whichever key the file has.
+inline Eigen::Matrix4d read_extrinsic(const NpzFile& file, const VisualInertialNpzOptions& options, std::string& key) {
+  const bool forward = file.contains("imu_T_cam"), backward = file.contains("cam_T_imu");
+  if (forward && backward) throw parse_error(file.path() + ": has both 'imu_T_cam' and 'cam_T_imu'; keep one");
+  if (!forward && !backward) throw parse_error(file.path() + ": key 'imu_T_cam' (or 'cam_T_imu') is missing");
+  key = forward ? "imu_T_cam" : "cam_T_imu";
+  const Eigen::Matrix4d T = read_rigid_transform(file, key);
+  if (forward) return se3::inverse(T);
+  if (!options.cam_T_imu_translation_is_camera_position) return T;
+  const Eigen::Matrix3d R = se3::rotation(T);
+  return se3::make(R, -R * se3::translation(T));  // translation = the camera's position in the IMU frame
+}
+
+inline double read_scalar(const NpzFile& file, const std::string& key) {
+  const auto a = file.array(key);
+  const std::string what = file.path() + ": key '" + key + "'";
+  if (a.values.size() != 1) throw parse_error(what + ": expected one value, found " + std::to_string(a.values.size()));
+  return require_shape(a, a.shape, what).values[0];
+}
+
+}  // namespace detail
+
+inline VisualInertialDataset read_visual_inertial_npz(const std::string& path, const VisualInertialNpzOptions& options = {}) {
+  const NpzFile file(path);
+  const auto what = [&](const std::string& key) { return path + ": key '" + key + "'"; };
+  VisualInertialDataset data;
+  data.path = path;
+
+  const auto stamps = file.array("time_stamps");
+  if (stamps.values.empty() || stamps.shape.empty() || (stamps.shape.size() == 2 && stamps.shape[0] != 1) || stamps.shape.size() > 2)
+    throw parse_error(what("time_stamps") + ": expected shape (1, T) or (T,)");
+  detail::require_shape(stamps, stamps.shape, what("time_stamps"));
+  const std::size_t T = stamps.values.size();
+  data.time_stamps = stamps.values;
+  for (std::size_t k = 1; k < T; ++k)
+    if (!(data.time_stamps[k] > data.time_stamps[k - 1]))
+      throw parse_error(what("time_stamps") + ": frame " + std::to_string(k) + " is not later than frame " +
+                        std::to_string(k - 1) + " (dt <= 0)");
+
+  const std::string angular_key = file.contains("angular_velocity") ? "angular_velocity" : "rotational_velocity";
+  if (!file.contains(angular_key)) throw parse_error(what("angular_velocity") + " (or 'rotational_velocity') is missing");
+  const auto v = file.array("linear_velocity"), w = file.array(angular_key);
+  detail::require_shape(v, {3, T}, what("linear_velocity"));
+  detail::require_shape(w, {3, T}, what(angular_key));
+
+  const auto K = file.array("K");
+  detail::require_shape(K, {3, 3}, what("K"));
+  data.calibration = {.fx = K.values[0], .fy = K.values[4], .cx = K.values[2], .cy = K.values[5],
+                      .baseline = detail::read_scalar(file, "b")};
+  if (!(data.calibration.fx > 0.0 && data.calibration.fy > 0.0))
+    throw parse_error(what("K") + ": focal lengths must be positive");
+  if (!(data.calibration.baseline > 0.0)) throw parse_error(what("b") + ": the baseline must be positive");
+  data.cam_T_imu = detail::read_extrinsic(file, options, data.extrinsic_key);
+
+  const auto features = file.array("features");
+  if (features.shape.size() != 3 || features.shape[0] != 4 || features.shape[2] != T)
+    throw parse_error(what("features") + ": expected shape (4, M, " + std::to_string(T) + ")");
+  detail::require_shape(features, features.shape, what("features"));
+  const std::size_t M = features.shape[1];
+  data.landmark_count = M;
+
+  std::vector<std::vector<Observation<Eigen::Vector4d>>> frames(T);
+  for (std::size_t m = 0; m < M; ++m)
+    for (std::size_t k = 0; k < T; ++k) {
+      Eigen::Vector4d z;
+      int unseen = 0;
+      for (std::size_t c = 0; c < 4; ++c) {
+        z(static_cast<Eigen::Index>(c)) = features.values[(c * M + m) * T + k];
+        unseen += z(static_cast<Eigen::Index>(c)) == -1.0;
+      }
+      if (unseen == 4) continue;
+      if (unseen > 0) {
+        ++data.incomplete_observations;
+        continue;
+      }
+      frames[k].push_back({static_cast<LandmarkId>(m), z});
+      ++data.observation_count;
+    }
+  data.first_observations = std::move(frames[0]);
+  data.steps.reserve(T - 1);
+  for (std::size_t k = 1; k < T; ++k) {
+    se3::Vector6d u;
+    u << v.values[k - 1], v.values[T + k - 1], v.values[2 * T + k - 1], w.values[k - 1], w.values[T + k - 1],
+        w.values[2 * T + k - 1];
+    data.steps.push_back({u, data.time_stamps[k] - data.time_stamps[k - 1], std::move(frames[k])});
+  }
+  return data;
+}
+
+}  // namespace sextant::io
