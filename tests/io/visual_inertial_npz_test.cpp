@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
 #include <map>
 
 #include "support/shared_data.hpp"
@@ -281,6 +282,49 @@ TEST(VisualInertialNpz, ReadsTheSeedsDataSets) {
   const Eigen::Vector3d camera_in_imu = se3::translation(se3::inverse(clean.cam_T_imu));
   EXPECT_GT(camera_in_imu.x(), 0.5);
   EXPECT_GT(camera_in_imu.z(), 0.3);
+}
+
+/// Median |uL - predicted uL| [px] over every later sighting of each landmark seen at least five
+/// times, the landmark triangulated at its first sighting and the poses dead-reckoned from the
+/// (noise-free) velocities: the extrinsic reading that fits the images better gives the smaller value.
+double median_reprojection_error(const VisualInertialDataset& data) {
+  std::vector<Eigen::Matrix4d> poses{Eigen::Matrix4d::Identity()};
+  for (const auto& step : data.steps) poses.push_back(se3::normalized(poses.back() * se3::exp(step.dt * step.control)));
+  StereoPixelsSe3 camera;
+  camera.calibration = data.calibration;
+  camera.cam_T_imu = data.cam_T_imu;
+  std::map<LandmarkId, std::vector<std::pair<std::size_t, Eigen::Vector4d>>> sightings;
+  for (const auto& o : data.first_observations) sightings[o.landmark_id].push_back({0, o.z});
+  for (std::size_t k = 0; k < data.steps.size(); ++k)
+    for (const auto& o : data.steps[k].observations) sightings[o.landmark_id].push_back({k + 1, o.z});
+  std::vector<double> errors;
+  for (const auto& [id, seen] : sightings) {
+    if (seen.size() < 5 || seen.front().second(0) - seen.front().second(2) <= 1.0) continue;
+    const Eigen::Vector3d m = camera.initialize(poses[seen.front().first], seen.front().second).m;
+    for (std::size_t i = 1; i < seen.size(); ++i) {
+      try {
+        errors.push_back(std::abs(camera.predict(poses[seen[i].first], m).z(0) - seen[i].second(0)));
+      } catch (const numerical_error&) {
+        errors.push_back(1e3);  // behind the camera: as wrong as it gets
+      }
+    }
+  }
+  std::nth_element(errors.begin(), errors.begin() + static_cast<std::ptrdiff_t>(errors.size() / 2), errors.end());
+  return errors[errors.size() / 2];
+}
+
+TEST(VisualInertialNpz, TheCamTImuTranslationOfThe0027FilesIsTheCameraPosition) {
+  // ../shared/data/README.md: in 0027_*.npz, cam_T_imu's rotation maps IMU to camera axes but its
+  // translation looks like the camera's position in the IMU frame. Checked against the images: the
+  // landmarks of 0027_clean reproject better with that reading than with a proper cam_T_imu.
+  const auto path = test::shared_data("ece276a/0027_clean.npz");
+  SEXTANT_REQUIRE_DATA(path);
+  const double as_position = median_reprojection_error(read_visual_inertial_npz(path));
+  const double as_proper =
+      median_reprojection_error(read_visual_inertial_npz(path, {.cam_T_imu_translation_is_camera_position = false}));
+  std::printf("0027_clean median reprojection error: translation read as camera position %.2f px, as proper cam_T_imu %.2f px\n",
+              as_position, as_proper);
+  EXPECT_LT(as_position, as_proper);
 }
 
 }  // namespace
