@@ -9,6 +9,7 @@
 #include "sextant/models/se2_odometry.hpp"
 #include "sextant/sim/ship_2d.hpp"
 #include "support/batch_least_squares.hpp"
+#include "sextant/sim/ordered_draws.hpp"
 
 namespace sextant {
 namespace {
@@ -86,10 +87,10 @@ TEST(GraphSlam, Se2ProblemConvergesAndWindowedInitializationAgrees) {
     truth = Se2Odometry{}.predict(truth, {delta, odometry_cov}, 1.0).x;
     true_poses.push_back(truth);
     Step<OdometryIncrement2D, Eigen::Vector2d> step{
-        {delta + Eigen::Vector3d(0.1 * unit(rng), 0.1 * unit(rng), 0.063 * unit(rng)), odometry_cov}, 1.0, {}};
+        {delta + Eigen::Vector3d(0.1, 0.1, 0.063).cwiseProduct(sim::ordered_draws<3>(unit, rng)), odometry_cov}, 1.0, {}};
     for (std::size_t j = 0; j < landmarks.size(); ++j) {
       const Eigen::Vector2d z = sensor.predict(truth, landmarks[j]).z;
-      if (z.x() > 0.0 && z.norm() < 6.0) step.observations.push_back({j, z + 0.1 * Eigen::Vector2d(unit(rng), unit(rng))});
+      if (z.x() > 0.0 && z.norm() < 6.0) step.observations.push_back({j, z + 0.1 * sim::ordered_draws<2>(unit, rng)});
     }
     steps.push_back(step);
   }

@@ -15,6 +15,7 @@
 #include "sextant/backends/seif_slam.hpp"
 #include "sextant/models/beacon_ship_2d.hpp"
 #include "sextant/testing/circle_world.hpp"
+#include "sextant/sim/ordered_draws.hpp"
 
 namespace sextant {
 namespace {
@@ -44,7 +45,7 @@ std::vector<Step> make_steps(bool outliers) {
     for (auto& o : step.observations) {
       const bool bad = k > kBeacons && is_outlier(rng);  // draws the same sequence with and without outliers
       const double scale = bad && outliers ? kOutlierFactor : 1.0;
-      o.z += scale * Eigen::Vector2d(noise(rng), noise(rng));
+      o.z += scale * sim::ordered_draws<2>(noise, rng);
       if (bad && outliers) step.outliers.insert(o.landmark_id);
     }
     steps.push_back(std::move(step));

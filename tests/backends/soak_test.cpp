@@ -14,6 +14,7 @@
 #include "sextant/backends/ekf_slam.hpp"
 #include "sextant/backends/seif_slam.hpp"
 #include "sextant/testing/circle_world.hpp"
+#include "sextant/sim/ordered_draws.hpp"
 
 #ifndef SEXTANT_SOAK_STEPS
 #define SEXTANT_SOAK_STEPS 100000
@@ -65,7 +66,7 @@ std::vector<Check> soak(Estimator& estimator, MatrixOf matrix, const char* name)
     const int k = static_cast<int>(step % kBeacons);  // the world loops: lap after lap
     estimator.predict(world.control(k), 1.0);
     auto z = world.observations(k);
-    for (auto& o : z) o.z += Eigen::Vector2d(noise(rng), noise(rng));
+    for (auto& o : z) o.z += sim::ordered_draws<2>(noise, rng);
     estimator.update(z);
     if (step % kCheckEvery == 0) {
       const auto pose = estimator.pose();

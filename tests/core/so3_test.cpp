@@ -10,6 +10,7 @@
 #include "sextant/eval/rotation_error.hpp"
 #include "sextant/models/euler_camera_12d.hpp"
 #include "sextant/eval/metrics.hpp"
+#include "sextant/sim/ordered_draws.hpp"
 
 namespace sextant {
 namespace {
@@ -60,7 +61,7 @@ TEST(RotationError, NeesOfACorrectCovarianceAveragesThreeDegreesOfFreedom) {
   const int draws = 4000;
   double sum = 0.0;
   for (int i = 0; i < draws; ++i) {
-    const Eigen::Vector3d eta_hat = eta + L * Eigen::Vector3d(n(rng), n(rng), n(rng));
+    const Eigen::Vector3d eta_hat = eta + L * sim::ordered_draws<3>(n, rng);
     const auto r = eval::rotation_error(euler_yxz::rotation(eta), euler_yxz::rotation(eta_hat),
                                         euler_yxz::body_jacobian(eta_hat), C);
     sum += r.nees;

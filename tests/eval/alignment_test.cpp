@@ -1,4 +1,5 @@
 #include "sextant/eval/alignment.hpp"
+#include "sextant/sim/ordered_draws.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +16,7 @@ TEST(Alignment, RecoversARigidMotionExactlyIn2dAnd3d) {
   const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   const Eigen::Vector3d t(4.0, -2.0, 0.5);
   for (int i = 0; i < 20; ++i) {
-    truth.emplace_back(unit(rng), unit(rng), unit(rng));
+    truth.push_back(sim::ordered_draws<3>(unit, rng));
     moved.push_back(R.transpose() * (truth.back() - t));  // estimate = T^-1(truth)
   }
   const auto T = align_rigidly<3>(moved, truth);

@@ -1,4 +1,5 @@
 #include "sextant/eval/metrics.hpp"
+#include "sextant/sim/ordered_draws.hpp"
 
 #include <gtest/gtest.h>
 
@@ -63,10 +64,10 @@ std::vector<double> correlated_run_averages(std::mt19937_64& rng, int runs, int 
   std::normal_distribution<double> unit(0.0, 1.0);
   std::vector<double> out;
   for (int i = 0; i < runs; ++i) {
-    Eigen::Vector2d e(unit(rng), unit(rng));
+    Eigen::Vector2d e = sim::ordered_draws<2>(unit, rng);
     double sum = 0.0;
     for (int k = 0; k < steps; ++k) {
-      e = rho * e + std::sqrt(1.0 - rho * rho) * Eigen::Vector2d(unit(rng), unit(rng));
+      e = rho * e + std::sqrt(1.0 - rho * rho) * sim::ordered_draws<2>(unit, rng);
       sum += e.squaredNorm();
     }
     out.push_back(sum / steps);

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "sextant/testing/model_checks.hpp"
+#include "sextant/sim/ordered_draws.hpp"
 
 namespace sextant {
 namespace {
@@ -57,7 +58,8 @@ TEST(BeaconShip2D, UnbiasedNoiseModelMatchesSampledDisplacementErrors) {
   Eigen::Matrix2d sum_sq = Eigen::Matrix2d::Zero();
   const BeaconShip2D linearized{1.0, 0.26, HeadingNoise::linearized};
   for (int i = 0; i < samples; ++i) {
-    const Eigen::Vector2d u_observed(u_true(0) + motion.sigma_v * unit(rng), u_true(1) + motion.sigma_heading * unit(rng));
+    const Eigen::Vector2d n = sim::ordered_draws<2>(unit, rng);
+    const Eigen::Vector2d u_observed(u_true(0) + motion.sigma_v * n(0), u_true(1) + motion.sigma_heading * n(1));
     const Eigen::Vector2d error = motion.predict(x, u_observed, 1.0).x - d_true;
     sum += error;
     sum_sq += error * error.transpose();
@@ -73,7 +75,8 @@ TEST(BeaconShip2D, UnbiasedNoiseModelMatchesSampledDisplacementErrors) {
   for (int i = 0; i < samples; ++i) {
     const double heading = u_true(1) + motion.sigma_heading * unit(rng);
     const Eigen::Vector2d d = u_true(0) * Eigen::Vector2d(std::cos(heading), std::sin(heading));
-    const Eigen::Vector2d u_observed(u_true(0) + motion.sigma_v * unit(rng), heading + motion.sigma_heading * unit(rng));
+    const Eigen::Vector2d n = sim::ordered_draws<2>(unit, rng);
+    const Eigen::Vector2d u_observed(u_true(0) + motion.sigma_v * n(0), heading + motion.sigma_heading * n(1));
     const Eigen::Vector2d error = motion.predict(x, u_observed, 1.0).x - d;
     pooled += error * error.transpose() / samples;
   }

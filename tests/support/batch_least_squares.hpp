@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sextant/sextant.hpp"
+#include "sextant/sim/ordered_draws.hpp"
 
 namespace sextant::test {
 
@@ -73,10 +74,11 @@ inline std::vector<Step<Eigen::Vector2d, Eigen::Vector2d>> random_linear_steps(i
   std::uniform_real_distribution<double> angle(-3.0, 3.0);
   std::vector<Step<Eigen::Vector2d, Eigen::Vector2d>> steps;
   for (int k = 0; k < num_steps; ++k) {
-    Step<Eigen::Vector2d, Eigen::Vector2d> step{Eigen::Vector2d(1.0 + 0.2 * unit(rng), angle(rng)), 0.5, {}};
+    const double heading = angle(rng);  // drawn first, as gcc evaluated the arguments (sim/ordered_draws.hpp)
+    Step<Eigen::Vector2d, Eigen::Vector2d> step{Eigen::Vector2d(1.0 + 0.2 * unit(rng), heading), 0.5, {}};
     for (int j = 0; j < num_landmarks; ++j)
       if ((k + j) % 3 != 0)  // not every landmark every step; new ones appear over time
-        step.observations.push_back({static_cast<LandmarkId>(10 + j), Eigen::Vector2d(3.0 * j + unit(rng), unit(rng))});
+        step.observations.push_back({static_cast<LandmarkId>(10 + j), Eigen::Vector2d(3.0 * j, 0.0) + sim::ordered_draws<2>(unit, rng)});
     if (k < num_landmarks) step.observations.resize(std::min<std::size_t>(step.observations.size(), k + 1));
     steps.push_back(step);
   }

@@ -12,6 +12,7 @@
 
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/gaussian.hpp"
+#include "sextant/core/chi_square.hpp"
 #include "sextant/core/innovation_gate.hpp"
 #include "sextant/core/persistent_array.hpp"
 #include "sextant/core/update_result.hpp"
@@ -37,9 +38,10 @@ struct FastSlamOptions {
   std::uint64_t seed = 1;
   /// Per-particle data association (update_unassociated): a measurement whose smallest normalized
   /// innovation squared over a particle's landmarks exceeds this starts a new landmark there.
-  /// Default chi2(2 dof) at 0.9999: at 0.99 one re-observation in a hundred would become a duplicate
-  /// (seen on the ship, where a 2-3 sigma compass error happens every few dozen steps).
-  double new_landmark_nis = 18.42;
+  /// 0 (the default) = the chi-square quantile at 0.9999 for the measurement's dimension (2: 18.42,
+  /// 3: 21.11, 4: 23.51); at 0.99 one re-observation in a hundred would become a duplicate (seen on
+  /// the ship, where a 2-3 sigma compass error happens every few dozen steps).
+  double new_landmark_nis = 0.0;
   /// Ids given to the landmarks that particles create in update_unassociated: first, first + 1, ...
   /// A landmark keeps its id in every particle that descends from the one that created it.
   LandmarkId first_unassociated_id = LandmarkId{1} << 62;

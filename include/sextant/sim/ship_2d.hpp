@@ -15,6 +15,7 @@
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/observation.hpp"
 #include "sextant/models/beacon_ship_2d.hpp"
+#include "sextant/sim/ordered_draws.hpp"
 
 namespace sextant::sim {
 
@@ -70,7 +71,7 @@ inline std::map<LandmarkId, Eigen::Vector2d> place_beacons(const Ship2DOptions& 
     const Eigen::Vector2d a = coast[edge], b = coast[(edge + 1) % coast.size()];
     const int count = static_cast<int>(std::floor((b - a).norm() / o.beacon_spacing));
     for (int i = 0; i < count; ++i) {
-      const Eigen::Vector2d p = a + (b - a) * (i + 0.5) / count + Eigen::Vector2d(jitter(rng), jitter(rng));
+      const Eigen::Vector2d p = a + (b - a) * (i + 0.5) / count + ordered_draws<2>(jitter, rng);
       const bool open_sea = edge == 2 && p.x() > o.open_sea_from_x;
       if (!open_sea) beacons.emplace(next_id++, p);
     }
@@ -92,7 +93,7 @@ inline Ship2DDataset simulate_ship_2d(const Ship2DOptions& o) {
   const auto corners = detail::route_corners(o);
   Eigen::Vector2d pose = corners[0];
   data.true_poses.push_back(pose);
-  data.prior.mean = pose + o.prior_sigma * Eigen::Vector2d(unit(rng), unit(rng));
+  data.prior.mean = pose + o.prior_sigma * ordered_draws<2>(unit, rng);
   data.prior.cov = o.prior_sigma * o.prior_sigma * Eigen::Matrix2d::Identity();
 
   std::size_t target = 1;
@@ -107,10 +108,11 @@ inline Ship2DDataset simulate_ship_2d(const Ship2DOptions& o) {
 
     Step<Eigen::Vector2d, Eigen::Vector2d> step;
     step.dt = o.dt;
-    step.control = Eigen::Vector2d(v + o.sigma_v * unit(rng), heading + o.sigma_heading * unit(rng));
+    const Eigen::Vector2d control_noise = ordered_draws<2>(unit, rng);
+    step.control = Eigen::Vector2d(v + o.sigma_v * control_noise.x(), heading + o.sigma_heading * control_noise.y());
     for (const auto& [id, beacon] : data.true_landmarks)
       if ((beacon - pose).norm() <= o.sensor_range)
-        step.observations.push_back({id, beacon - pose + o.sigma_beacon * Eigen::Vector2d(unit(rng), unit(rng))});
+        step.observations.push_back({id, beacon - pose + o.sigma_beacon * ordered_draws<2>(unit, rng)});
     data.steps.push_back(std::move(step));
   }
   return data;

@@ -34,6 +34,9 @@ FastSlam<Motion, Sensor, Map>::FastSlam(Motion motion, Sensor sensor, const Pose
     throw invalid_input_error("FastSlamOptions: resample_threshold must be in [0, 1]");
   if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
   cholesky_or_throw(prior.cov, "prior covariance");
+  if (options_.new_landmark_nis == 0.0) options_.new_landmark_nis = chi_square_quantile(Z, 0.9999);
+  if (!(options_.new_landmark_nis > 0.0) || !std::isfinite(options_.new_landmark_nis))
+    throw invalid_input_error("FastSlamOptions: new_landmark_nis must be positive and finite (0: the default)");
   gate_ = InnovationGate(Z, options_.gate_probability);
   particles_.resize(options_.particles);
   for (auto& particle : particles_) particle.x = sample(prior.mean, prior.cov, rng_);
