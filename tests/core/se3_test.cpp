@@ -126,16 +126,20 @@ TEST(Se3, SeriesAndClosedFormsAgreeAtTheirSwitch) {
   }
 }
 
-TEST(Se3Space, PlusAndMinusAreInverseAndRetractOnTheRight) {
+TEST(Se3Space, PlusAndMinusAreInverseAndRetractInTheWorldOrBodyFrame) {
   static_assert(StateSpace<Se3Space, Eigen::Matrix4d, 6>);
+  static_assert(StateSpace<Se3BodySpace, Eigen::Matrix4d, 6>);
   const auto tangents = random_tangents(8, 40);
   for (std::size_t i = 0; i + 1 < tangents.size(); i += 2) {
     const Eigen::Matrix4d T = se3::exp(tangents[i]);
     const Vector6d d = 0.5 * tangents[i + 1];
-    const Eigen::Matrix4d moved = Se3Space::plus(T, d);
-    EXPECT_TRUE(moved.isApprox(T * se3::exp(d), 1e-12));
-    EXPECT_LT((Se3Space::minus(moved, T) - d).norm(), 1e-9 * (1.0 + d.norm()));
+    EXPECT_TRUE(Se3Space::plus(T, d).isApprox(se3::exp(d) * T, 1e-12));
+    EXPECT_TRUE(Se3BodySpace::plus(T, d).isApprox(T * se3::exp(d), 1e-12));
+    EXPECT_LT((Se3Space::minus(Se3Space::plus(T, d), T) - d).norm(), 1e-9 * (1.0 + d.norm()));
+    EXPECT_LT((Se3BodySpace::minus(Se3BodySpace::plus(T, d), T) - d).norm(), 1e-9 * (1.0 + d.norm()));
     EXPECT_TRUE(Se3Space::minus(T, T).isZero(1e-12));
+    // The two tangents of one perturbation differ by the adjoint: exp(d^) T = T exp((Ad(T^-1) d)^).
+    EXPECT_TRUE(Se3BodySpace::minus(Se3Space::plus(T, d), T).isApprox(se3::adjoint(se3::inverse(T)) * d, 1e-9));
   }
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <type_traits>
 
 #include "sextant/core/concepts.hpp"
 #include "sextant/testing/model_checks.hpp"
@@ -14,8 +15,9 @@ using se3::Vector6d;
 
 /// KITTI-like rectified stereo: 0.54 m baseline, 718 px focal length, IMU x forward, y left, z up,
 /// camera z forward, x right, y down, mounted 1 m forward and 0.5 m up.
-StereoPixelsSe3 kitti_like_camera() {
-  StereoPixelsSe3 camera;
+template <Se3Perturbation P = Se3Perturbation::world>
+StereoPixelsSe3Of<P> kitti_like_camera() {
+  StereoPixelsSe3Of<P> camera;
   camera.calibration = {.fx = 718.9, .fy = 718.9, .cx = 607.2, .cy = 185.2, .baseline = 0.54};
   Eigen::Matrix3d R_cam_imu;  // rows: camera axes in IMU coordinates
   R_cam_imu << 0, -1, 0, 0, 0, -1, 1, 0, 0;
@@ -35,39 +37,55 @@ struct RandomScene {
   }
   Eigen::Matrix4d pose() { return se3::exp(tangent(20.0, 1.0)); }
   /// A point 3-40 m ahead of the camera of `camera` at pose T, within +-0.5 of the optical axis.
-  Eigen::Vector3d landmark_in_view(const Eigen::Matrix4d& T, const StereoPixelsSe3& camera) {
+  template <class Camera>
+  Eigen::Vector3d landmark_in_view(const Eigen::Matrix4d& T, const Camera& camera) {
     std::uniform_real_distribution<double> depth(3.0, 40.0), lateral(-0.5, 0.5);
     const double d = depth(rng);
     const Eigen::Vector4d q(lateral(rng) * d, lateral(rng) * d, d, 1.0);
-    return (T * se3::inverse(camera.cam_T_imu) * q).head<3>();
+    return (T * se3::inverse(camera.cam_T_imu) * q).template head<3>();
   }
 };
 
-TEST(StereoImuSe3, ModelsFitTheConcepts) {
-  static_assert(MotionModel<ImuVelocitySe3>);
-  static_assert(HasBetweenFactor<ImuVelocitySe3>);
-  static_assert(MeasurementModelFor<StereoPixelsSe3, ImuVelocitySe3>);
+/// Both perturbations of the pose (core/se3_space.hpp) give the same models in other coordinates;
+/// every check runs for each.
+template <class Perturbation>
+class StereoImuSe3Perturbations : public ::testing::Test {
+ public:
+  static constexpr Se3Perturbation perturbation = Perturbation::value;
+  using Imu = ImuVelocitySe3Of<perturbation>;
+  using Camera = StereoPixelsSe3Of<perturbation>;
+  using Space = Se3SpaceOf<perturbation>;
+};
+using Perturbations = ::testing::Types<std::integral_constant<Se3Perturbation, Se3Perturbation::world>,
+                                       std::integral_constant<Se3Perturbation, Se3Perturbation::body>>;
+TYPED_TEST_SUITE(StereoImuSe3Perturbations, Perturbations);
+
+TYPED_TEST(StereoImuSe3Perturbations, ModelsFitTheConcepts) {
+  using Imu = typename TestFixture::Imu;
+  static_assert(MotionModel<Imu>);
+  static_assert(HasBetweenFactor<Imu>);
+  static_assert(MeasurementModelFor<typename TestFixture::Camera, Imu>);
 }
 
-TEST(StereoImuSe3, MotionJacobiansMatchCentralDifferencesAtRandomStates) {
+TYPED_TEST(StereoImuSe3Perturbations, MotionJacobiansMatchCentralDifferencesAtRandomStates) {
   RandomScene scene(1);
-  ImuVelocitySe3 imu;
+  typename TestFixture::Imu imu;
   imu.W.diagonal() << 0.25, 0.25, 0.25, 0.0025, 0.0025, 0.0025;
   for (int i = 0; i < 50; ++i) {
     const Eigen::Matrix4d T = scene.pose();
     const Vector6d u = scene.tangent(5.0, 0.3);
     const double dt = 0.1 * (1 + i % 3);
     EXPECT_TRUE(testing::check_motion_jacobians(imu, T, u, dt)) << testing::check_motion_jacobians(imu, T, u, dt).report;
-    const Eigen::Matrix4d to = Se3Space::plus(imu.predict(T, u, dt).x, scene.tangent(0.3, 0.05));
+    const Eigen::Matrix4d to = TestFixture::Space::plus(imu.predict(T, u, dt).x, scene.tangent(0.3, 0.05));
     const auto between = testing::check_between_jacobians(imu, T, to, u, dt);
     EXPECT_TRUE(between) << between.report;
   }
 }
 
-TEST(StereoImuSe3, ProcessNoiseIsTheVelocityNoisePropagatedThroughTheMotion) {
+TYPED_TEST(StereoImuSe3Perturbations, ProcessNoiseIsTheVelocityNoisePropagatedThroughTheMotion) {
   // R = V W V^T with V = d minus(T exp(dt (u + w)^), T exp(dt u^)) / dw, V by central differences.
   RandomScene scene(2);
-  ImuVelocitySe3 imu;
+  typename TestFixture::Imu imu;
   imu.W.diagonal() << 0.25, 0.16, 0.09, 0.0025, 0.0016, 0.0036;
   for (int i = 0; i < 20; ++i) {
     const Eigen::Matrix4d T = scene.pose();
@@ -78,19 +96,19 @@ TEST(StereoImuSe3, ProcessNoiseIsTheVelocityNoisePropagatedThroughTheMotion) {
     for (int k = 0; k < 6; ++k) {
       Vector6d h = Vector6d::Zero();
       h(k) = 1e-6;
-      V.col(k) = (Se3Space::minus(T * se3::exp(dt * (u + h)), mean) - Se3Space::minus(T * se3::exp(dt * (u - h)), mean)) / 2e-6;
+      V.col(k) = (TestFixture::Space::minus(T * se3::exp(dt * (u + h)), mean) - TestFixture::Space::minus(T * se3::exp(dt * (u - h)), mean)) / 2e-6;
     }
     EXPECT_TRUE(imu.predict(T, u, dt).R.isApprox(V * imu.W * V.transpose(), 1e-6));
   }
 }
 
-TEST(StereoImuSe3, MeasurementJacobiansAndTriangulationMatchAtRandomStates) {
+TYPED_TEST(StereoImuSe3Perturbations, MeasurementJacobiansAndTriangulationMatchAtRandomStates) {
   RandomScene scene(3);
-  const auto camera = kitti_like_camera();
+  const auto camera = kitti_like_camera<TestFixture::perturbation>();
   for (int i = 0; i < 100; ++i) {
     const Eigen::Matrix4d T = scene.pose();
     const Eigen::Vector3d m = scene.landmark_in_view(T, camera);
-    const auto check = testing::check_measurement_jacobians<ImuVelocitySe3>(camera, T, m);
+    const auto check = testing::check_measurement_jacobians<typename TestFixture::Imu>(camera, T, m);
     EXPECT_TRUE(check) << check.report;
   }
 }
@@ -118,7 +136,7 @@ TEST(StereoImuSe3, PointsBehindTheCameraAndNonPositiveDisparitiesAreErrorsNotNaN
     try {
       (void)camera.predict(T, m);
       ADD_FAILURE() << "a point at depth <= 0 was predicted";
-    } catch (const numerical_error& e) {
+    } catch (const unobservable_error& e) {
       EXPECT_NE(std::string(e.what()).find("behind the camera"), std::string::npos) << e.what();
     }
   }
@@ -126,10 +144,27 @@ TEST(StereoImuSe3, PointsBehindTheCameraAndNonPositiveDisparitiesAreErrorsNotNaN
     try {
       (void)camera.initialize(T, Eigen::Vector4d(600.0, 180.0, uR, 180.0));
       ADD_FAILURE() << "disparity " << 600.0 - uR << " was triangulated";
-    } catch (const numerical_error& e) {
+    } catch (const unobservable_error& e) {
       EXPECT_NE(std::string(e.what()).find("disparity"), std::string::npos) << e.what();
     }
   }
+}
+
+TEST(StereoImuSe3, TheWorldPerturbationHasAnEstimateFreeMotionJacobian) {
+  // exp(d^) T exp(tau u^): the world-frame error is carried over unchanged (G = I), which is what
+  // lets first-estimate Jacobians keep the global pose unobservable (backends/ekf_slam.hpp).
+  RandomScene scene(4);
+  ImuVelocitySe3 imu;
+  const auto prediction = imu.predict(scene.pose(), scene.tangent(5.0, 0.3), 0.1);
+  EXPECT_TRUE(prediction.J_x_x.isIdentity(0.0));
+}
+
+TEST(StereoImuSe3, TriangulationBelowTheSmallestDisparityIsUnusableNotAnError) {
+  auto camera = kitti_like_camera();
+  camera.min_disparity = 30.0;
+  const Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  EXPECT_NO_THROW((void)camera.initialize(T, Eigen::Vector4d(640.0, 180.0, 600.0, 180.0)));  // 40 px
+  EXPECT_THROW((void)camera.initialize(T, Eigen::Vector4d(620.0, 180.0, 600.0, 180.0)), unobservable_error);  // 20 px
 }
 
 }  // namespace

@@ -34,6 +34,12 @@ struct EkfOptions {
   bool batch_update = true;  ///< one joint correction per step (one pass over P) or one per observation
   CovarianceUpdate covariance_update = CovarianceUpdate::symmetric;
   double gate_probability = 0.0;  ///< in (0, 1): reject observations with NIS above the chi2 quantile; 0 = off
+  /// First-estimate Jacobians (Huang, Mourikis and Roumeliotis 2008, for landmarks): H is evaluated
+  /// at each landmark's first estimate, the residual at its current one. With a motion Jacobian that
+  /// does not depend on the estimate along the unobservable directions (G = I for SE(3) poses
+  /// perturbed in the world frame), every H then shares one null space and the filter gains no
+  /// information about the unobservable global pose (docs/results/vislam.md). Off: the textbook EKF.
+  bool first_estimate_jacobians = false;
 };
 
 /// EKF-SLAM: joint Gaussian over the robot state and a growing set of landmarks. Only the lower
@@ -117,7 +123,9 @@ class EkfSlam {
     std::vector<std::pair<LandmarkId, Init>> new_landmarks;
   };
 
-  std::vector<Linearized> linearize(std::span<const ObservationType> known) const;
+  /// The observations the model can use here; the others go to result.unusable.
+  std::vector<Linearized> linearize(std::span<const ObservationType> known, UpdateResult& result) const;
+  void use_first_estimate_jacobians(Linearized& lin, std::size_t slot, const Measurement& z) const;
   Eigen::Matrix<double, Eigen::Dynamic, Z> cross_covariance(const Linearized& obs) const;
   /// H_i C: observation i's Jacobian applied to C (rows of the stacked state), from the robot and
   /// landmark rows only.
@@ -139,6 +147,7 @@ class EkfSlam {
   InnovationGate gate_;
   State x_;
   Eigen::VectorXd landmark_means_;
+  Eigen::VectorXd first_means_;  ///< each landmark's mean when it was added (first_estimate_jacobians)
   GrowableSquareMatrix cov_;  ///< P; only its lower triangle is kept up to date
   LandmarkPool pool_;
 };

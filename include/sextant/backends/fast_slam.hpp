@@ -146,10 +146,16 @@ class FastSlam {
   static State sample(const State& mean, const Eigen::Matrix<double, X, X>& cov, std::mt19937_64& rng);
   void apply_pending_motion_v1(Transaction& t) const;
   /// What one landmark update adds to the particle's log weight, and whether the gate rejected it.
+  /// What became of one observation in one particle.
+  enum Outcome : char { used = 0, gated = 1, unusable = 2 };
   struct LandmarkUpdate {
     double log_likelihood;
-    bool rejected;
+    Outcome outcome;
   };
+  auto predict_if_observable(const State& x, const Landmark& m) const
+      -> std::optional<decltype(std::declval<const Sensor&>().predict(x, m))>;
+  std::vector<ObservationType> add_new_landmarks(std::vector<Particle>& particles, std::span<const ObservationType> fresh,
+                                                 std::vector<LandmarkId>& unusable) const;
   LandmarkUpdate update_landmark(Particle& particle, std::size_t index, const Measurement& z, bool unassociated,
                                  bool gated) const;
   template <class Llt>

@@ -6,6 +6,7 @@
 #include <Eigen/SparseCore>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -57,6 +58,9 @@ struct OptimizationSummary {
   std::vector<double> seconds;  ///< time since optimize() began at each entry of cost
   bool converged = false;
   double seconds_linearize = 0.0, seconds_eliminate = 0.0, seconds_solve = 0.0, seconds_recover = 0.0;
+  /// Measurement factors the model could not evaluate at the final estimate (unobservable_error, e.g.
+  /// a landmark behind the camera), left out of the last linearization.
+  std::size_t unobservable_factors = 0;
 };
 
 /// GraphSLAM: records the prior, every motion and every measurement through the filters' face
@@ -155,6 +159,8 @@ class GraphSlam {
   static void require_factorizable_extension(const Eigen::Matrix<double, X, X>& P, const Eigen::Matrix<double, D, X>& J,
                                              const Eigen::Matrix<double, D, D>& C, const std::string& what);
   Linearization linearize(std::size_t pose_count) const;
+  auto predict_if_observable(const State& x, const Landmark& m) const
+      -> std::optional<decltype(std::declval<const Sensor&>().predict(x, m))>;
   Eigen::VectorXd solve_by_landmark_schur(const Linearization& system, OptimizationSummary& summary) const;
   Eigen::VectorXd solve_full(const Linearization& system, OptimizationSummary& summary) const;
   Eigen::VectorXd solve(const Linearization& system, double lambda, OptimizationSummary& summary) const;

@@ -137,10 +137,11 @@ class SeifSlam {
   static Eigen::Index offset_of(std::size_t slot) { return X + M * static_cast<Eigen::Index>(slot); }
   Landmark landmark_mean(std::size_t slot) const { return landmark_means_.template segment<M>(M * slot); }
 
-  Linearized linearize(const ObservationType& observation) const;
+  /// Nothing when the model cannot use the observation here (its id then goes to `unusable`).
+  std::optional<Linearized> linearize(const ObservationType& observation, std::vector<LandmarkId>& unusable) const;
   MeasurementInformation measurement_information(const Linearized& lin) const;
   void gate(std::vector<Linearized>& observations, std::vector<LandmarkId>& rejected) const;
-  NewLandmark new_landmark(const ObservationType& observation) const;
+  std::optional<NewLandmark> new_landmark(const ObservationType& observation, std::vector<LandmarkId>& unusable) const;
   void add(const MeasurementInformation& info);
   void augment(const NewLandmark& landmark);
   /// What a failed step restores besides the information form (which journals itself).

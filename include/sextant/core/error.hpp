@@ -37,6 +37,15 @@ class numerical_error : public error {
   using error::error;
 };
 
+/// A sensor model cannot use this observation at the current estimate: a point at or behind the
+/// camera cannot be projected, a stereo pair with disparity <= 0 cannot be triangulated. Back-ends
+/// skip such an observation alone and list it in UpdateResult::unusable; every other
+/// numerical_error fails the whole update.
+class unobservable_error : public numerical_error {
+ public:
+  using numerical_error::numerical_error;
+};
+
 /// A file or text record that cannot be read; the message names the source and line.
 class parse_error : public error {
  public:

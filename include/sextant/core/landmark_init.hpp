@@ -2,7 +2,9 @@
 /// \file The inverse measurement model of a new landmark, checked: every back-end adds landmarks
 /// through this one call.
 
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "sextant/core/error.hpp"
 #include "sextant/core/gaussian.hpp"
@@ -23,6 +25,20 @@ auto initialize_landmark(const Sensor& sensor, const State& x, const Measurement
     throw numerical_error("covariance of new landmark " + std::to_string(id) +
                           " overflows: it is measured too far away for the noise model");
   return init;
+}
+
+/// initialize_landmark, or nothing when the model cannot place this landmark (unobservable_error,
+/// e.g. a stereo pair with disparity <= 0): its id then goes to `unusable`.
+template <class Sensor, class State, class Measurement>
+auto initialize_if_observable(const Sensor& sensor, const State& x, const Measurement& z, LandmarkId id,
+                              std::vector<LandmarkId>& unusable)
+    -> std::optional<decltype(initialize_landmark(sensor, x, z, id))> {
+  try {
+    return initialize_landmark(sensor, x, z, id);
+  } catch (const unobservable_error&) {
+    unusable.push_back(id);
+    return std::nullopt;
+  }
 }
 
 }  // namespace sextant

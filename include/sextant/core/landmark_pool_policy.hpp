@@ -34,6 +34,7 @@ struct PoolStepRecord {
   std::size_t added = 0;
   std::size_t evicted = 0;
   std::size_t refused = 0;  ///< observations of new landmarks left out (per-step limit or pool full)
+  std::size_t unusable = 0;  ///< observations the back-end could not use (UpdateResult::unusable)
 };
 
 /// What one step does: landmarks to remove first, then the observations to hand to update().
@@ -90,12 +91,20 @@ class LandmarkPoolPolicy {
   void evicted(LandmarkId id) { forget(id); }
 
   /// Records a plan once the back-end has updated with its observations (after evicting);
-  /// `step` orders the last sightings.
+  /// `step` orders the last sightings. `unusable`: the ids the back-end could not use
+  /// (UpdateResult::unusable): not sightings, and a new one among them was not added.
   template <class Measurement>
-  void commit(const PoolPlan<Measurement>& plan, std::size_t step) {
+  void commit(const PoolPlan<Measurement>& plan, std::size_t step, std::span<const LandmarkId> unusable = {}) {
     for (LandmarkId id : plan.evict) forget(id);
-    for (const auto& observation : plan.observations) see(observation.landmark_id, step);
-    history_.push_back({size(), plan.added, plan.evict.size(), plan.refused});
+    const std::unordered_set<LandmarkId> skipped(unusable.begin(), unusable.end());
+    std::size_t not_added = 0;
+    for (const auto& observation : plan.observations) {
+      if (!skipped.contains(observation.landmark_id))
+        see(observation.landmark_id, step);
+      else if (!contains(observation.landmark_id))
+        ++not_added;
+    }
+    history_.push_back({size(), plan.added - not_added, plan.evict.size(), plan.refused, skipped.size()});
   }
 
  private:
@@ -118,7 +127,7 @@ class LandmarkPoolPolicy {
 };
 
 /// One step of a back-end through the pool: evict, then update with the admitted observations,
-/// then record. Policy and back-end stay in step if the back-end throws: each removal is recorded
+/// then record (new landmarks the back-end could not use are not recorded as added). Policy and back-end stay in step if the back-end throws: each removal is recorded
 /// as it succeeds, the sightings only after the update succeeds.
 template <class Backend, class Measurement>
 UpdateResult update_through_pool(Backend& backend, LandmarkPoolPolicy& policy,
@@ -129,7 +138,7 @@ UpdateResult update_through_pool(Backend& backend, LandmarkPoolPolicy& policy,
     policy.evicted(id);
   }
   UpdateResult result = backend.update(std::span<const Observation<Measurement>>(plan.observations));
-  policy.commit(plan, step);
+  policy.commit(plan, step, std::span<const LandmarkId>(result.unusable));
   return result;
 }
 

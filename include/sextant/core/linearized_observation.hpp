@@ -4,7 +4,9 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "sextant/core/error.hpp"
 #include "sextant/core/gaussian.hpp"
@@ -46,6 +48,20 @@ auto linearize_observation(const Sensor& sensor, const State& x, const Landmark&
                           ": its squared residual weighted by Q^-1 overflows (the measurement is too far from "
                           "its prediction for the noise model)");
   return out;
+}
+
+/// linearize_observation, or nothing when the model cannot use the observation at this estimate
+/// (unobservable_error, e.g. the landmark behind the camera): its id then goes to `unusable`.
+template <class Sensor, class State, class Landmark, class Measurement>
+auto linearize_if_observable(const Sensor& sensor, const State& x, const Landmark& m, const Measurement& z,
+                             LandmarkId id, Eigen::Index offset, std::vector<LandmarkId>& unusable)
+    -> std::optional<decltype(linearize_observation(sensor, x, m, z, id, offset))> {
+  try {
+    return linearize_observation(sensor, x, m, z, id, offset);
+  } catch (const unobservable_error&) {
+    unusable.push_back(id);
+    return std::nullopt;
+  }
 }
 
 }  // namespace sextant

@@ -12,6 +12,9 @@ struct UpdateResult {
   std::size_t corrected = 0;             ///< observations of known landmarks used in the correction
   std::size_t initialized = 0;           ///< new landmarks added to the map
   std::vector<LandmarkId> rejected;      ///< observations rejected by the Mahalanobis gate
+  /// Observations the sensor model cannot use at the current estimate (unobservable_error: a point
+  /// behind the camera, a disparity <= 0), skipped one by one; a new landmark listed here is not added.
+  std::vector<LandmarkId> unusable;
 };
 
 }  // namespace sextant

@@ -2,8 +2,9 @@
 /// \file Visual-inertial models on SE(3), after seed 004: an IMU pose driven by measured linear and
 /// angular velocity (eqs. 13, 37-38), and a rectified stereo camera that measures a 3D point as its
 /// pixel pair (uL, vL, uR, vR) = M pi(cam_T_imu T^-1 m) (eqs. 7, 24-26, 31, 41). The pose is
-/// world_T_imu, perturbed on the right (core/se3_space.hpp); the seed's inverse pose U = T^-1
-/// with a left perturbation is the same model with the tangent's sign flipped.
+/// world_T_imu, perturbed in the world frame by default (ImuVelocitySe3, StereoPixelsSe3) or in the
+/// body frame (the ...Body aliases; core/se3_space.hpp); the seed's inverse pose U = T^-1 with a
+/// left perturbation is the body form with the tangent's sign flipped.
 /// Derivations: docs/derivations/stereo_imu_se3.md.
 
 #include <Eigen/Core>
@@ -17,13 +18,16 @@
 namespace sextant {
 
 /// T' = T exp(tau u^), u = (v, omega) in the IMU frame (eq. 13 for T = U^-1). With the velocity
-/// noise w ~ N(0, W) held over the step, T' = T exp(tau (u + w)^) and, to first order,
-/// d' = Ad(exp(-tau u^)) d + tau J_r(tau u) w: G = Ad(exp(-tau u^)) (eq. 38's exp(-tau u^) in
-/// adjoint form), R = tau^2 J_r W J_r^T.
-struct ImuVelocitySe3 {
+/// noise w ~ N(0, W) held over the step, T' = T exp(tau (u + w)^) ~ T exp(tau u^) exp(tau J_r(tau u) w).
+/// Body perturbation (T exp(d^)): d' = Ad(exp(-tau u^)) d + tau J_r w, so G = Ad(exp(-tau u^))
+/// (eq. 38's exp(-tau u^) in adjoint form) and R = tau^2 J_r W J_r^T.
+/// World perturbation (exp(d^) T): d' = d + Ad(T') tau J_r w, so G = I and
+/// R = Ad(T') tau^2 J_r W J_r^T Ad(T')^T: the error of the pose does not depend on the estimate.
+template <Se3Perturbation P>
+struct ImuVelocitySe3Of {
   using State = Eigen::Matrix4d;
   using Control = se3::Vector6d;  ///< (v [m/s], omega [rad/s]) in the IMU frame
-  using Space = Se3Space;
+  using Space = Se3SpaceOf<P>;
   static constexpr int kDim = 6;
 
   se3::Matrix6d W = se3::Matrix6d::Identity();  ///< covariance of the velocity noise (per sample)
@@ -34,14 +38,22 @@ struct ImuVelocitySe3 {
     const se3::Matrix6d Jr = se3::right_jacobian(step);
     MotionPrediction<State, 6> out;
     out.x = se3::normalized(x * increment);
-    out.J_x_x = se3::adjoint(se3::inverse(increment));
-    out.R = dt * dt * Jr * W * Jr.transpose();
+    const se3::Matrix6d R_body = dt * dt * Jr * W * Jr.transpose();
+    if constexpr (P == Se3Perturbation::world) {
+      const se3::Matrix6d Ad = se3::adjoint(out.x);
+      out.J_x_x.setIdentity();
+      out.R = Ad * R_body * Ad.transpose();
+    } else {
+      out.J_x_x = se3::adjoint(se3::inverse(increment));
+      out.R = R_body;
+    }
     out.R = (0.5 * (out.R + out.R.transpose())).eval();
     return out;
   }
 
-  /// r = log(exp(tau u^)^-1 T_from^-1 T_to): zero when T_to = predict(T_from, u); J_to = J_r^-1(r),
-  /// J_from = -J_r^-1(r) Ad(T_to^-1 T_from); cov = tau^2 J_r W J_r^T at the control.
+  /// r = log(exp(tau u^)^-1 T_from^-1 T_to): zero when T_to = predict(T_from, u); cov = tau^2 J_r W
+  /// J_r^T at the control. Body: J_to = J_r^-1(r), J_from = -J_r^-1(r) Ad(T_to^-1 T_from).
+  /// World: J_to = J_r^-1(r) Ad(T_to^-1) = -J_from.
   BetweenFactor<6> between(const State& from, const State& to, const Control& u, double dt) const {
     const se3::Vector6d step = dt * u;
     const Eigen::Matrix4d relative = se3::inverse(from) * to;
@@ -49,13 +61,21 @@ struct ImuVelocitySe3 {
     BetweenFactor<6> out;
     out.r = se3::log(se3::inverse(se3::exp(step)) * relative);
     const se3::Matrix6d Jr_inv = se3::right_jacobian_inverse(out.r);
-    out.J_to = Jr_inv;
-    out.J_from = -Jr_inv * se3::adjoint(se3::inverse(relative));
+    if constexpr (P == Se3Perturbation::world) {
+      out.J_to = Jr_inv * se3::adjoint(se3::inverse(to));
+      out.J_from = -out.J_to;
+    } else {
+      out.J_to = Jr_inv;
+      out.J_from = -Jr_inv * se3::adjoint(se3::inverse(relative));
+    }
     out.cov = dt * dt * Jr * W * Jr.transpose();
     out.cov = (0.5 * (out.cov + out.cov.transpose())).eval();
     return out;
   }
 };
+
+using ImuVelocitySe3 = ImuVelocitySe3Of<Se3Perturbation::world>;
+using ImuVelocitySe3Body = ImuVelocitySe3Of<Se3Perturbation::body>;
 
 /// Intrinsics of a rectified stereo pair: both cameras share K, the right one sits `baseline`
 /// metres along the left camera's x axis.
@@ -76,8 +96,10 @@ struct StereoCalibration {
 /// z = (uL, vL, uR, vR) = M pi(cam_T_imu T^-1 m), pi(q) = q / q_3 (eqs. 24-25), pixel noise
 /// sigma on each coordinate. A point at or behind the camera (depth <= min_depth) cannot be
 /// predicted; a pixel pair with disparity uL - uR <= 0 cannot be triangulated: both throw
-/// numerical_error naming the problem, never a NaN.
-struct StereoPixelsSe3 {
+/// unobservable_error naming the problem (never a NaN), and the back-ends skip that observation
+/// alone and list it in UpdateResult::unusable.
+template <Se3Perturbation P>
+struct StereoPixelsSe3Of {
   using Landmark = Eigen::Vector3d;
   using Measurement = Eigen::Vector4d;
 
@@ -85,21 +107,31 @@ struct StereoPixelsSe3 {
   Eigen::Matrix4d cam_T_imu = Eigen::Matrix4d::Identity();  ///< maps IMU-frame points into the left camera
   double pixel_sigma = 1.0;                                 ///< [px], each of uL, vL, uR, vR
   double min_depth = 1e-3;                                  ///< [m] in front of the left camera
+  /// [px] the smallest disparity uL - uR a new landmark is triangulated from. The depth's relative
+  /// error is about sqrt(2) pixel_sigma / disparity; far beyond ~10% the linearized triangulation
+  /// misstates the depth's distribution, so such points are left unusable as new landmarks.
+  /// 0: every positive disparity.
+  double min_disparity = 0.0;
 
-  /// H_m = M dpi/dq(q) cam_T_imu T^-1 P^T (eq. 31), H_x = -M dpi/dq(q) cam_T_imu (T^-1 m)^odot
-  /// (eq. 41 with the sign of the right perturbation).
+  /// H_m = M dpi/dq(q) cam_T_imu T^-1 P^T (eq. 31). H_x = M dpi/dq(q) cam_T_imu d(T^-1 m)/dd with
+  /// d(T^-1 m)/dd = -(T^-1 m)^odot for the body perturbation (eq. 41 with its sign) and
+  /// -T^-1 m^odot for the world perturbation.
   MeasurementPrediction<4, 6, 3> predict(const Eigen::Matrix4d& x, const Landmark& m) const {
-    const Eigen::Vector4d s = se3::inverse(x) * m.homogeneous();  // the point in the IMU frame
+    const Eigen::Matrix4d x_inv = se3::inverse(x);
+    const Eigen::Vector4d s = x_inv * m.homogeneous();  // the point in the IMU frame
     const Eigen::Vector4d q = cam_T_imu * s;
     if (!(q(2) > min_depth))
-      throw numerical_error("stereo camera: the landmark is at or behind the camera (depth " + std::to_string(q(2)) +
-                            " m)");
+      throw unobservable_error("stereo camera: the landmark is at or behind the camera (depth " + std::to_string(q(2)) +
+                               " m)");
     const Eigen::Matrix4d M = calibration.stereo_matrix();
     const Eigen::Matrix4d M_dpi = M * projection_jacobian(q);
     MeasurementPrediction<4, 6, 3> out;
     out.z = M * (q / q(2));
-    out.J_z_m = M_dpi * (cam_T_imu * se3::inverse(x)).leftCols<3>();
-    out.J_z_x = -M_dpi * cam_T_imu * se3::odot(s);
+    out.J_z_m = M_dpi * (cam_T_imu * x_inv).leftCols<3>();
+    if constexpr (P == Se3Perturbation::world)
+      out.J_z_x = -M_dpi * cam_T_imu * x_inv * se3::odot(m.homogeneous());
+    else
+      out.J_z_x = -M_dpi * cam_T_imu * se3::odot(s);
     out.Q = pixel_sigma * pixel_sigma * Eigen::Matrix4d::Identity();
     return out;
   }
@@ -112,8 +144,11 @@ struct StereoPixelsSe3 {
     const auto& c = calibration;
     const double disparity = z(0) - z(2);
     if (!(disparity > 0.0))
-      throw numerical_error("stereo camera: disparity uL - uR = " + std::to_string(disparity) +
-                            " px, not positive: the point cannot be triangulated");
+      throw unobservable_error("stereo camera: disparity uL - uR = " + std::to_string(disparity) +
+                               " px, not positive: the point cannot be triangulated");
+    if (disparity < min_disparity)
+      throw unobservable_error("stereo camera: disparity uL - uR = " + std::to_string(disparity) + " px, below " +
+                               std::to_string(min_disparity) + " px: too far to triangulate as a Gaussian");
     const double depth = c.fx * c.baseline / disparity;
     const double v = 0.5 * (z(1) + z(3));
     const Eigen::Vector3d q((z(0) - c.cx) * depth / c.fx, (v - c.cy) * depth / c.fy, depth);
@@ -133,7 +168,10 @@ struct StereoPixelsSe3 {
     LandmarkInit<3, 6, 4> out;
     out.m = (x * s).head<3>();
     out.J_m_z = world_T_cam.topLeftCorner<3, 3>() * dq_dz;
-    out.J_m_x = (x * se3::odot(s)).topRows<3>();  // T exp(d^) s ~ T s + T s^odot d
+    if constexpr (P == Se3Perturbation::world)
+      out.J_m_x = se3::odot(x * s).topRows<3>();  // exp(d^) T s ~ T s + (T s)^odot d
+    else
+      out.J_m_x = (x * se3::odot(s)).topRows<3>();  // T exp(d^) s ~ T s + T s^odot d
     out.Q = pixel_sigma * pixel_sigma * Eigen::Matrix4d::Identity();
     return out;
   }
@@ -148,5 +186,8 @@ struct StereoPixelsSe3 {
     return J / q(2);
   }
 };
+
+using StereoPixelsSe3 = StereoPixelsSe3Of<Se3Perturbation::world>;
+using StereoPixelsSe3Body = StereoPixelsSe3Of<Se3Perturbation::body>;
 
 }  // namespace sextant

@@ -50,7 +50,7 @@ UpdateResult EkfSlam<Motion, Sensor>::update(std::span<const ObservationType> ob
     return result;
   }
   const State x_before = x_;
-  const Eigen::VectorXd means_before = landmark_means_;
+  const Eigen::VectorXd means_before = landmark_means_, first_before = first_means_;
   const GrowableSquareMatrix cov_before = cov_;
   try {
     const std::span<const ObservationType> all_known(known);
@@ -59,6 +59,7 @@ UpdateResult EkfSlam<Motion, Sensor>::update(std::span<const ObservationType> ob
   } catch (...) {
     x_ = x_before;
     landmark_means_ = means_before;
+    first_means_ = first_before;
     cov_ = cov_before;
     throw;
   }
@@ -66,15 +67,32 @@ UpdateResult EkfSlam<Motion, Sensor>::update(std::span<const ObservationType> ob
 }
 
 template <class Motion, class Sensor>
-auto EkfSlam<Motion, Sensor>::linearize(std::span<const ObservationType> known) const -> std::vector<Linearized> {
+auto EkfSlam<Motion, Sensor>::linearize(std::span<const ObservationType> known, UpdateResult& result) const
+    -> std::vector<Linearized> {
   std::vector<Linearized> out;
   out.reserve(known.size());
   for (const auto& observation : known) {
     const std::size_t slot = pool_.slot(observation.landmark_id);
-    out.push_back(linearize_observation(sensor_, x_, landmark_mean(slot), observation.z, observation.landmark_id,
-                                        offset_of(slot)));
+    auto lin = linearize_if_observable(sensor_, x_, landmark_mean(slot), observation.z, observation.landmark_id,
+                                       offset_of(slot), result.unusable);
+    if (!lin) continue;
+    if (options_.first_estimate_jacobians) use_first_estimate_jacobians(*lin, slot, observation.z);
+    out.push_back(std::move(*lin));
   }
   return out;
+}
+
+/// H at the landmark's first estimate, the residual as it was (at the current estimate). Where the
+/// model cannot predict from the first estimate (behind the camera from here), H stays current.
+template <class Motion, class Sensor>
+void EkfSlam<Motion, Sensor>::use_first_estimate_jacobians(Linearized& lin, std::size_t slot,
+                                                           const Measurement& z) const {
+  std::vector<LandmarkId> unusable_from_first;
+  const auto first = linearize_if_observable(sensor_, x_, Landmark(first_means_.template segment<M>(M * slot)), z,
+                                             lin.id, lin.offset, unusable_from_first);
+  if (!first) return;
+  lin.J_z_x = first->J_z_x;
+  lin.J_z_m = first->J_z_m;
 }
 
 /// P H_i^T for one observation, from the robot and landmark column blocks only: O(n).
@@ -194,7 +212,7 @@ template <class Motion, class Sensor>
 auto EkfSlam<Motion, Sensor>::plan(std::span<const ObservationType> known, std::span<const ObservationType> fresh,
                                    UpdateResult& result) const -> Plan {
   Plan out;
-  std::vector<Linearized> observations = linearize(known);
+  std::vector<Linearized> observations = linearize(known, result);
   gate(observations, result);
   State x_after = x_;
   if (!observations.empty()) {
@@ -207,7 +225,9 @@ auto EkfSlam<Motion, Sensor>::plan(std::span<const ObservationType> known, std::
   // (|P_m,j| <= sqrt(P_mm P_jj)): augment() in commit() cannot overflow.
   const Eigen::Matrix<double, X, X> P_xx = symmetric_diagonal_block<X>(cov_.view(), 0);
   for (const auto& observation : fresh) {
-    auto init = initialize_landmark(sensor_, x_after, observation.z, observation.landmark_id);
+    auto initialized = initialize_if_observable(sensor_, x_after, observation.z, observation.landmark_id, result.unusable);
+    if (!initialized) continue;
+    auto& init = *initialized;
     if (!(init.J_m_x * P_xx * init.J_m_x.transpose()).allFinite())
       throw numerical_error("covariance of new landmark " + std::to_string(observation.landmark_id) + " overflows");
     out.new_landmarks.emplace_back(observation.landmark_id, std::move(init));
@@ -239,6 +259,8 @@ void EkfSlam<Motion, Sensor>::augment(LandmarkId id, const Init& init) {
       symmetrized(init.J_m_x * P_xx * init.J_m_x.transpose() + init.J_m_z * init.Q * init.J_m_z.transpose());
   landmark_means_.conservativeResize(landmark_means_.size() + M);
   landmark_means_.template tail<M>() = init.m;
+  first_means_.conservativeResize(first_means_.size() + M);
+  first_means_.template tail<M>() = init.m;
 }
 
 /// Marginalization in moment form: drop the landmark's rows and columns (thesis §4.2.2).
@@ -250,6 +272,8 @@ void EkfSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
   cov_.remove_block_by_moving_last(offset_of(removal.freed_slot), M);
   landmark_means_.template segment<M>(M * removal.freed_slot) = landmark_means_.template segment<M>(M * removal.last_slot);
   landmark_means_.conservativeResize(landmark_means_.size() - M);
+  first_means_.template segment<M>(M * removal.freed_slot) = first_means_.template segment<M>(M * removal.last_slot);
+  first_means_.conservativeResize(first_means_.size() - M);
 }
 
 template <class Motion, class Sensor>

@@ -114,11 +114,13 @@ auto FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::siz
                                                     bool unassociated, bool gated) const -> LandmarkUpdate {
   auto& map = unassociated ? particle.unassociated : particle.landmarks;
   const LandmarkGaussian<M>& L = map[index];
-  const auto pred = sensor_.predict(particle.x, L.mean);
+  const auto prediction = predict_if_observable(particle.x, L.mean);
+  if (!prediction) return {0.0, unusable};
+  const auto& pred = *prediction;
   const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(z, pred.z);
   const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
   const auto llt = cholesky_or_throw(S, "landmark innovation covariance");
-  if (gated && gate_.rejects(llt, nu)) return {log_likelihood_at_gate_edge(llt), true};
+  if (gated && gate_.rejects(llt, nu)) return {log_likelihood_at_gate_edge(llt), Outcome::gated};
   const Eigen::Matrix<double, M, Z> K = llt.solve(pred.J_z_m * L.cov).transpose();
   const Eigen::Matrix<double, M, M> I_KH = Eigen::Matrix<double, M, M>::Identity() - K * pred.J_z_m;
   LandmarkGaussian<M> updated{L.mean + K * nu, symmetrized(I_KH * L.cov * I_KH.transpose() + K * pred.Q * K.transpose()),
@@ -127,7 +129,20 @@ auto FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::siz
   if (!updated.mean.allFinite() || !updated.cov.allFinite() || !std::isfinite(log_likelihood))
     throw numerical_error("landmark update is not finite");
   map.set(index, std::move(updated));
-  return {log_likelihood, false};
+  return {log_likelihood, used};
+}
+
+/// The model's prediction, or nothing where it cannot predict (unobservable_error: in this
+/// particle the landmark is behind the camera). Such an observation neither shapes the particle
+/// nor weighs on it: a Gaussian likelihood is not defined there.
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::predict_if_observable(const State& x, const Landmark& m) const
+    -> std::optional<decltype(std::declval<const Sensor&>().predict(x, m))> {
+  try {
+    return sensor_.predict(x, m);
+  } catch (const unobservable_error&) {
+    return std::nullopt;
+  }
 }
 
 /// FastSLAM 2.0 proposal (eqs. 82-92), in Kalman form so that R may be singular: starting from
@@ -146,14 +161,19 @@ std::vector<char> FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& pa
   for (std::size_t i = 0; i < known.size(); ++i) {
     const auto& observation = known[i];
     const LandmarkGaussian<M>& L = particle.landmarks[index_.at(observation.landmark_id)];
-    const auto pred = sensor_.predict(mean, L.mean);
+    const auto prediction = predict_if_observable(mean, L.mean);
+    if (!prediction) {
+      rejected[i] = unusable;
+      continue;
+    }
+    const auto& pred = *prediction;
     const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(observation.z, pred.z);
     const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_x * cov * pred.J_z_x.transpose() +
                                                       pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
     const auto llt = cholesky_or_throw(S, "proposal innovation covariance");
     if (gate_.rejects(llt, nu)) {
       particle.log_weight += log_likelihood_at_gate_edge(llt);
-      rejected[i] = 1;
+      rejected[i] = gated;
       continue;
     }
     const Eigen::Matrix<double, X, Z> K = llt.solve(pred.J_z_x * cov).transpose();
@@ -183,30 +203,36 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
       const auto p = checked_motion_prediction(motion_, particle.x, t.pending.back().u, t.pending.back().dt);
       rejected[n] = sample_v2_proposal(particle, p.x, p.R, known, t.rng);
       for (std::size_t i = 0; i < known.size(); ++i)
-        if (!rejected[n][i]) update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false, false);
+        if (rejected[n][i] == used) {
+          const auto outcome = update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false, false).outcome;
+          if (outcome == unusable) rejected[n][i] = unusable;  // behind the camera from the sampled pose
+        }
     } else {
       for (const auto& observation : known) {
         const auto result = update_landmark(particle, index_.at(observation.landmark_id), observation.z, false, true);
         particle.log_weight += result.log_likelihood;
-        rejected[n].push_back(result.rejected);
+        rejected[n].push_back(result.outcome);
       }
     }
-    for (const auto& observation : fresh) {
-      const auto init = initialize_landmark(sensor_, particle.x, observation.z, observation.landmark_id);
-      particle.landmarks.push_back({init.m, symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose()), true,
-                                    observation.landmark_id});
+  }
+  UpdateResult result;
+  const auto added = add_new_landmarks(t.particles, fresh, result.unusable);
+  t.pending.clear();
+  const auto& best_rejected = rejected[best_particle(t.particles)];
+  std::size_t known_unusable = 0;
+  for (std::size_t i = 0; i < known.size(); ++i) {
+    if (best_rejected[i] == gated) result.rejected.push_back(known[i].landmark_id);
+    if (best_rejected[i] == unusable) {
+      result.unusable.push_back(known[i].landmark_id);
+      ++known_unusable;
     }
   }
-  t.pending.clear();
-  UpdateResult result{0, fresh.size(), {}};
-  const auto& best_rejected = rejected[best_particle(t.particles)];
-  for (std::size_t i = 0; i < known.size(); ++i)
-    if (best_rejected[i]) result.rejected.push_back(known[i].landmark_id);
-  result.corrected = known.size() - result.rejected.size();
+  result.corrected = known.size() - result.rejected.size() - known_unusable;
+  result.initialized = added.size();
   normalize_and_resample(t);
   auto index = index_;
   auto id_of_index = id_of_index_;
-  for (const auto& observation : fresh) {
+  for (const auto& observation : added) {
     index[observation.landmark_id] = id_of_index.size();
     id_of_index.push_back(observation.landmark_id);
   }
@@ -214,6 +240,35 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
   index_.swap(index);
   id_of_index_.swap(id_of_index);
   return result;
+}
+
+/// New landmarks from every particle's pose by the inverse model. One that the model cannot place
+/// from some particle's pose (unobservable_error) is left out of every particle, so that all
+/// particles hold the same ids; its id goes to `unusable`. Returns the observations added.
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::add_new_landmarks(std::vector<Particle>& particles,
+                                                      std::span<const ObservationType> fresh,
+                                                      std::vector<LandmarkId>& unusable) const
+    -> std::vector<ObservationType> {
+  std::vector<ObservationType> added;
+  std::vector<LandmarkGaussian<M>> per_particle;
+  for (const auto& observation : fresh) {
+    per_particle.clear();
+    std::vector<LandmarkId> failed;
+    for (const auto& particle : particles) {
+      const auto init = initialize_if_observable(sensor_, particle.x, observation.z, observation.landmark_id, failed);
+      if (!init) break;
+      per_particle.push_back(
+          {init->m, symmetrized(init->J_m_z * init->Q * init->J_m_z.transpose()), true, observation.landmark_id});
+    }
+    if (!failed.empty()) {
+      unusable.push_back(observation.landmark_id);
+      continue;
+    }
+    for (std::size_t n = 0; n < particles.size(); ++n) particles[n].landmarks.push_back(std::move(per_particle[n]));
+    added.push_back(observation);
+  }
+  return added;
 }
 
 /// Thesis §7.2: per particle, each measurement goes to the landmark of that particle with the

@@ -35,6 +35,7 @@ struct GraphSlam<Motion, Sensor>::Linearization {
   Eigen::VectorXd pose_rhs;
   std::vector<LandmarkTerms> landmarks;
   double cost = 0.0;
+  std::size_t unobservable = 0;  ///< measurement factors the model cannot evaluate here, left out
 
   Eigen::Index dim() const { return X * static_cast<Eigen::Index>(pose_count) + M * static_cast<Eigen::Index>(landmarks.size()); }
 
@@ -103,26 +104,46 @@ UpdateResult GraphSlam<Motion, Sensor>::update(std::span<const ObservationType> 
   // Linearize every new factor at the current estimate now, so that a factor no later
   // linearization could use (bad noise, an overflowing residual) is rejected where it enters
   // instead of making every later optimize(), map() and landmark() throw.
+  // An observation the model cannot use at the current estimate (unobservable_error) is left out.
+  UpdateResult result;
+  std::vector<const ObservationType*> used;
   for (const auto& observation : known)
-    linearize_observation(sensor_, poses_[pose], landmark_mean(pool_.slot(observation.landmark_id)), observation.z,
-                          observation.landmark_id, 0);
-  std::vector<LandmarkInit<M, X, Z>> inits;
+    if (linearize_if_observable(sensor_, poses_[pose], landmark_mean(pool_.slot(observation.landmark_id)),
+                                observation.z, observation.landmark_id, 0, result.unusable))
+      used.push_back(&observation);
+  std::vector<std::pair<const ObservationType*, LandmarkInit<M, X, Z>>> inits;
   for (const auto& observation : fresh) {
-    inits.push_back(initialize_landmark(sensor_, poses_[pose], observation.z, observation.landmark_id));
-    linearize_observation(sensor_, poses_[pose], inits.back().m, observation.z, observation.landmark_id, 0);
-    require_factorizable_extension<M>(prior_.cov, inits.back().J_m_x,
-                                      symmetrized(inits.back().J_m_z * inits.back().Q * inits.back().J_m_z.transpose()),
+    auto init = initialize_if_observable(sensor_, poses_[pose], observation.z, observation.landmark_id, result.unusable);
+    if (!init || !linearize_if_observable(sensor_, poses_[pose], init->m, observation.z, observation.landmark_id, 0,
+                                          result.unusable))
+      continue;
+    require_factorizable_extension<M>(prior_.cov, init->J_m_x, symmetrized(init->J_m_z * init->Q * init->J_m_z.transpose()),
                                       "GraphSLAM: new landmark " + std::to_string(observation.landmark_id));
+    inits.emplace_back(&observation, std::move(*init));
   }
-  for (const auto& observation : known) measurements_[pool_.slot(observation.landmark_id)].push_back({pose, observation.z});
-  for (std::size_t i = 0; i < fresh.size(); ++i) {
-    pool_.add(fresh[i].landmark_id);
-    measurements_.push_back({{pose, fresh[i].z}});
+  for (const ObservationType* observation : used)
+    measurements_[pool_.slot(observation->landmark_id)].push_back({pose, observation->z});
+  for (const auto& [observation, init] : inits) {
+    pool_.add(observation->landmark_id);
+    measurements_.push_back({{pose, observation->z}});
     landmark_means_.conservativeResize(landmark_means_.size() + M);
-    landmark_means_.template tail<M>() = inits[i].m;
+    landmark_means_.template tail<M>() = init.m;
   }
   touch();
-  return {known.size(), fresh.size(), {}};
+  result.corrected = used.size();
+  result.initialized = inits.size();
+  return result;
+}
+
+/// The model's prediction, or nothing where it cannot predict (unobservable_error).
+template <class Motion, class Sensor>
+auto GraphSlam<Motion, Sensor>::predict_if_observable(const State& x, const Landmark& m) const
+    -> std::optional<decltype(std::declval<const Sensor&>().predict(x, m))> {
+  try {
+    return sensor_.predict(x, m);
+  } catch (const unobservable_error&) {
+    return std::nullopt;
+  }
 }
 
 /// A new variable y = J x + v, v ~ N(0, C), tied to the newest pose x (a pose by a motion factor,
@@ -213,19 +234,23 @@ auto GraphSlam<Motion, Sensor>::linearize(std::size_t pose_count) const -> Linea
     terms.slot = slot;
     for (const auto& record : measurements_[slot]) {
       if (record.pose >= pose_count) continue;
-      const auto prediction = sensor_.predict(poses_[record.pose], landmark_mean(slot));
-      const Eigen::Matrix<double, Z, 1> r = -sensor_.residual(record.z, prediction.z);
-      const auto llt = cholesky_or_throw(prediction.Q, "measurement noise Q of landmark " + std::to_string(pool_.id_at(slot)));
+      const auto prediction = predict_if_observable(poses_[record.pose], landmark_mean(slot));
+      if (!prediction) {  // e.g. an iterate put the landmark behind this camera: the factor sits this one out
+        ++sys.unobservable;
+        continue;
+      }
+      const Eigen::Matrix<double, Z, 1> r = -sensor_.residual(record.z, prediction->z);
+      const auto llt = cholesky_or_throw(prediction->Q, "measurement noise Q of landmark " + std::to_string(pool_.id_at(slot)));
       const double s = r.dot(llt.solve(r));
       const double w = options_.measurement_loss.weight(s);  // IRLS: rho'(s) W
-      const Eigen::Matrix<double, Z, X> W_Jx = w * llt.solve(prediction.J_z_x);
-      const Eigen::Matrix<double, Z, M> W_Jm = w * llt.solve(prediction.J_z_m);
+      const Eigen::Matrix<double, Z, X> W_Jx = w * llt.solve(prediction->J_z_x);
+      const Eigen::Matrix<double, Z, M> W_Jm = w * llt.solve(prediction->J_z_m);
       const Eigen::Matrix<double, Z, 1> W_r = w * llt.solve(r);
-      sys.pose_diagonal[record.pose] += prediction.J_z_x.transpose() * W_Jx;
-      rhs(record.pose) -= prediction.J_z_x.transpose() * W_r;
-      terms.diagonal += prediction.J_z_m.transpose() * W_Jm;
-      terms.rhs -= prediction.J_z_m.transpose() * W_r;
-      terms.poses.emplace_back(record.pose, prediction.J_z_x.transpose() * W_Jm);
+      sys.pose_diagonal[record.pose] += prediction->J_z_x.transpose() * W_Jx;
+      rhs(record.pose) -= prediction->J_z_x.transpose() * W_r;
+      terms.diagonal += prediction->J_z_m.transpose() * W_Jm;
+      terms.rhs -= prediction->J_z_m.transpose() * W_r;
+      terms.poses.emplace_back(record.pose, prediction->J_z_x.transpose() * W_Jm);
       sys.cost += options_.measurement_loss.cost(s);
     }
     if (!terms.poses.empty()) sys.landmarks.push_back(std::move(terms));
@@ -398,6 +423,7 @@ OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_cou
       break;
     }
   }
+  summary.unobservable_factors = sys.unobservable;
   if (final_system) *final_system = std::move(sys);
   return summary;
 }

@@ -70,9 +70,11 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
 
 /// H^T Q^-1 H and H^T Q^-1 nu of one observation, by blocks (thesis eqs. 29-30).
 template <class Motion, class Sensor>
-auto SeifSlam<Motion, Sensor>::linearize(const ObservationType& observation) const -> Linearized {
+auto SeifSlam<Motion, Sensor>::linearize(const ObservationType& observation, std::vector<LandmarkId>& unusable) const
+    -> std::optional<Linearized> {
   const std::size_t slot = pool_.slot(observation.landmark_id);
-  return linearize_observation(sensor_, x_, landmark_mean(slot), observation.z, observation.landmark_id, offset_of(slot));
+  return linearize_if_observable(sensor_, x_, landmark_mean(slot), observation.z, observation.landmark_id,
+                                 offset_of(slot), unusable);
 }
 
 template <class Motion, class Sensor>
@@ -92,14 +94,17 @@ auto SeifSlam<Motion, Sensor>::measurement_information(const Linearized& lin) co
 /// A new landmark in information form: the conditional m = init.m + J_m_x dx + v, v ~ N(0, C),
 /// C = J_m_z Q J_m_z^T, adds [J_m_x^T W J_m_x, -J_m_x^T W; -W J_m_x, W] with W = C^-1 and no residual.
 template <class Motion, class Sensor>
-auto SeifSlam<Motion, Sensor>::new_landmark(const ObservationType& observation) const -> NewLandmark {
-  const Init init = initialize_landmark(sensor_, x_, observation.z, observation.landmark_id);
+auto SeifSlam<Motion, Sensor>::new_landmark(const ObservationType& observation, std::vector<LandmarkId>& unusable) const
+    -> std::optional<NewLandmark> {
+  const auto initialized = initialize_if_observable(sensor_, x_, observation.z, observation.landmark_id, unusable);
+  if (!initialized) return std::nullopt;
+  const Init& init = *initialized;
   const Eigen::Matrix<double, M, M> C = symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose());
   const auto llt = cholesky_or_throw(
       C, "covariance J_m_z Q J_m_z^T of new landmark " + std::to_string(observation.landmark_id));
   const Eigen::Matrix<double, M, M> W = symmetrized(llt.solve(Eigen::Matrix<double, M, M>::Identity()));
-  return {observation.landmark_id, init.m, symmetrized(init.J_m_x.transpose() * W * init.J_m_x),
-          -init.J_m_x.transpose() * W, W};
+  return NewLandmark{observation.landmark_id, init.m, symmetrized(init.J_m_x.transpose() * W * init.J_m_x),
+                     -init.J_m_x.transpose() * W, W};
 }
 
 template <class Motion, class Sensor>
@@ -129,8 +134,9 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
   // Linearize everything first; the rest runs as one transaction, undone if any step throws.
   std::vector<Linearized> linearized;
   linearized.reserve(known.size());
-  for (const auto& observation : known) linearized.push_back(linearize(observation));
-  UpdateResult result{0, fresh.size(), {}};
+  UpdateResult result;
+  for (const auto& observation : known)
+    if (auto lin = linearize(observation, result.unusable)) linearized.push_back(std::move(*lin));
   gate(linearized, result.rejected);
   result.corrected = linearized.size();
   std::vector<MeasurementInformation> measurements;
@@ -138,7 +144,9 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
   for (const auto& lin : linearized) measurements.push_back(measurement_information(lin));
   std::vector<NewLandmark> landmarks;
   landmarks.reserve(fresh.size());
-  for (const auto& observation : fresh) landmarks.push_back(new_landmark(observation));
+  for (const auto& observation : fresh)
+    if (auto landmark = new_landmark(observation, result.unusable)) landmarks.push_back(std::move(*landmark));
+  result.initialized = landmarks.size();
 
   atomically([&] {
     std::vector<std::size_t> observed;
