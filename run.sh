@@ -24,6 +24,7 @@ case "$mode" in
     configure -DSEXTANT_BUILD_TESTS=OFF -DSEXTANT_BUILD_BENCHMARKS=OFF
     targets=(sextant-run)
     case " $* " in *globe*) targets+=(sextant-globe) ;; esac  # --dataset globe hands over to sextant-globe
+    case " $* " in *stereo-vi*|*.npz*) targets+=(sextant-vislam) ;; esac  # and stereo-vi / FILE.npz to sextant-vislam
     cmake --build "$build" -j"$jobs" --target "${targets[@]}"
     exec "$build/examples/sextant-run" "$@" ;;
   test|test-slow)

@@ -1,8 +1,10 @@
 // sextant-run: every back-end on the simulated ship and on MRPT rawlogs, scored against ground
 // truth, side by side. With no arguments: all back-ends on the ship Monte Carlo and on the kf-slam
 // demo rawlogs that Debian's mrpt-common installs. --dataset globe hands over to sextant-globe (the
-// thesis's 12D camera around a simulated globe), a program of its own so that the main job does not
-// compile it. See docs/runner.md.
+// thesis's 12D camera around a simulated globe), --dataset stereo-vi or FILE.npz to sextant-vislam
+// (visual-inertial SLAM on SE(3)): programs of their own so that the main job does not compile them.
+// See docs/runner.md.
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -79,12 +81,24 @@ bool wants_globe(const CliOptions& options) {
   return true;
 }
 
-int hand_over_to_globe(char** argv) {
-  const auto globe = std::filesystem::canonical("/proc/self/exe").parent_path() / "sextant-globe";
+/// --dataset stereo-vi and .npz files run in sextant-vislam (next to this program), all of them in one call.
+bool wants_vislam(const CliOptions& options) {
+  const auto& d = options.datasets;
+  const auto count = std::count_if(d.begin(), d.end(), is_vislam_dataset);
+  if (count == 0) return false;
+  if (static_cast<std::size_t>(count) != d.size())
+    throw invalid_input_error("--dataset stereo-vi and .npz files run alone (in the program sextant-vislam); give the "
+                              "other data sets in a second call");
+  return true;
+}
+
+/// Replaces this process by `program` (next to it) with the same arguments.
+int hand_over_to(const char* program, char** argv) {
+  const auto path = std::filesystem::canonical("/proc/self/exe").parent_path() / program;
   std::fflush(stdout);
-  ::execv(globe.c_str(), argv);
-  std::fprintf(stderr, "sextant-run: cannot start %s (%s): build it with cmake --build <build> --target sextant-globe, or "
-               "run ./run.sh main --dataset globe\n", globe.c_str(), std::strerror(errno));
+  ::execv(path.c_str(), argv);
+  std::fprintf(stderr, "sextant-run: cannot start %s (%s): build it with cmake --build <build> --target %s, or "
+               "run ./run.sh main with the same --dataset\n", path.c_str(), std::strerror(errno), program);
   return 1;
 }
 
@@ -94,7 +108,8 @@ int main(int argc, char** argv) {
   return runner_main(argc, argv, "sextant-run",
                      "sextant-run: SLAM back-ends on the simulated ship and on MRPT rawlogs, side by side",
                      [argv](CliOptions& options) {
-                       if (wants_globe(options)) return hand_over_to_globe(argv);
+                       if (wants_globe(options)) return hand_over_to("sextant-globe", argv);
+                       if (wants_vislam(options)) return hand_over_to("sextant-vislam", argv);
                        const RunnerConfig config = load_runner_config(options);
                        const auto kinds = parse_backends(options.backends);
                        std::vector<TableRow> rows;

@@ -30,10 +30,10 @@ inline void add_runner_options(CLI::App& app, CliOptions& options) {
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--dataset,-d", options.datasets,
-                 "ship | globe | mrpt-demos | <file.rawlog> | <file.txt> (iSAM/GTSAM planar text) | mrclam:<dir>:<robot 1-5|all> "
+                 "ship | globe | stereo-vi | <file.npz> | mrpt-demos | <file.rawlog> | <file.txt> (iSAM/GTSAM planar text) | mrclam:<dir>:<robot 1-5|all> "
                  "(repeatable; default: ship and the "
                  "MRPT kf-slam demos)");
-  app.add_option("--config,-c", options.config, "ini file (MRPT CConfigFile) with [ship] [globe] [rawlog] [ekf] [seif] [graph] "
+  app.add_option("--config,-c", options.config, "ini file (MRPT CConfigFile) with [ship] [globe] [vislam] [rawlog] [ekf] [seif] [graph] "
                                                 "[fastslam] [scene] keys; see --print-config");
   app.add_option("--out,-o", options.output.out, "directory for per-step CSV, TUM, .3Dscene files and summary.json");
   app.add_option("--associate", options.associate,
@@ -43,6 +43,11 @@ inline void add_runner_options(CLI::App& app, CliOptions& options) {
   app.add_flag("--plots", options.output.plots, "also write PNG plots of trajectory, map, error and NEES (needs --out or "
                                                 "writes to ./sextant-run-output)");
   app.add_flag("--print-config", options.print_config, "print every config key with its default and meaning, then exit");
+}
+
+/// A data set of sextant-vislam: the simulated stereo car or a .npz file.
+inline bool is_vislam_dataset(const std::string& dataset) {
+  return dataset == "stereo-vi" || std::filesystem::path(dataset).extension() == ".npz";
 }
 
 inline std::vector<BackendKind> parse_backends(const std::vector<std::string>& names) {

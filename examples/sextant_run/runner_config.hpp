@@ -44,6 +44,19 @@ struct GlobeSettings {
   int graph_updates = 10;              ///< GraphSLAM global updates after the windowed initialization
 };
 
+/// The visual-inertial runs' settings (run_vislam.cpp): the models' noise for .npz data (the
+/// simulator brings its own), the landmark pool and the gate.
+struct VislamSettings {
+  double velocity_sigma = 0.5;  ///< m/s per axis, noise of the IMU's linear velocity (.npz data)
+  double rate_sigma = 0.05;     ///< rad/s per axis, noise of its angular velocity (.npz data)
+  double pixel_sigma = 2.0;     ///< px, feature noise (.npz data)
+  double min_disparity = 2.0;   ///< px, smallest disparity a new landmark is triangulated from (.npz data)
+  PoolLimits pool{.max_landmarks = 150, .max_new_per_step = 20};
+  double gate_probability = 0.999;  ///< Mahalanobis gate of the filters
+  std::uint64_t seed = 1;           ///< stereo-vi simulation
+  int steps = 400;                  ///< stereo-vi frames (one loop)
+};
+
 /// Measurement ids withheld and found again by data association (EKF and SEIF), or used as given.
 struct AssociationSettings {
   std::optional<AssociationMethod> method;  ///< none: the data set's ids are used
@@ -59,6 +72,7 @@ struct RunnerConfig {
   GraphOptions graph;
   FastSlamOptions fastslam{.particles = 100, .resample_threshold = 0.1, .map_estimate = FastSlamMap::weighted_average};
   GlobeSettings globe;
+  VislamSettings vislam;
   io::MrclamOptions mrclam;
   AssociationSettings association;
   double scene_quantile = 3.0;
@@ -176,6 +190,28 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.globe.covariance_period = parse_integer<std::size_t>(v, 1); }},
       {"globe", "graph_updates", "10", "GraphSLAM global updates after the windowed initialization (thesis Table 10: 10)",
        [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = parse_integer<int>(v, 1); }},
+      {"vislam", "velocity_sigma", "0.5", "m/s: IMU linear velocity noise per axis (.npz data)",
+       [](RunnerConfig& c, const std::string& v) { c.vislam.velocity_sigma = positive(parse_number(v), v); }},
+      {"vislam", "rate_sigma", "0.05", "rad/s: IMU angular velocity noise per axis (.npz data)",
+       [](RunnerConfig& c, const std::string& v) { c.vislam.rate_sigma = positive(parse_number(v), v); }},
+      {"vislam", "pixel_sigma", "2", "px: stereo feature noise (.npz data)",
+       [](RunnerConfig& c, const std::string& v) { c.vislam.pixel_sigma = positive(parse_number(v), v); }},
+      {"vislam", "min_disparity", "2", "px: smallest disparity a new landmark is triangulated from (.npz data)",
+       [](RunnerConfig& c, const std::string& v) {
+         const double x = parse_number(v);
+         if (x < 0.0) throw invalid_input_error("'" + v + "' must be >= 0");
+         c.vislam.min_disparity = x;
+       }},
+      {"vislam", "max_landmarks", "150", "landmark pool capacity (EKF: <= 10 ms per frame on 03.npz)",
+       [](RunnerConfig& c, const std::string& v) { c.vislam.pool.max_landmarks = parse_integer<std::size_t>(v, 1); }},
+      {"vislam", "max_new_per_step", "20", "new landmarks per frame at most",
+       [](RunnerConfig& c, const std::string& v) { c.vislam.pool.max_new_per_step = parse_integer<std::size_t>(v, 1); }},
+      {"vislam", "gate_probability", "0.999", "Mahalanobis gate of the filters (0 = off)",
+       [](RunnerConfig& c, const std::string& v) { c.vislam.gate_probability = parse_gate_probability(v); }},
+      {"vislam", "seed", "1", "simulation seed of stereo-vi",
+       [](RunnerConfig& c, const std::string& v) { c.vislam.seed = parse_integer<std::uint64_t>(v, 0); }},
+      {"vislam", "steps", "400", "stereo-vi frames (one loop)",
+       [](RunnerConfig& c, const std::string& v) { c.vislam.steps = parse_integer<int>(v, 1); }},
       {"rawlog", "std_range", "0", "range noise, m; 0 = as stated in the rawlog",
        [](RunnerConfig& c, const std::string& v) {
          const double x = parse_number(v);

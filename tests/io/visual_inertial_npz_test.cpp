@@ -175,6 +175,19 @@ TEST_F(NpzFiles, ReadsStepsObservationsCalibrationAndExtrinsic) {
   EXPECT_TRUE((data.cam_T_imu * Eigen::Vector4d(1.5, 0.1, -0.6, 1.0)).isApprox(Eigen::Vector4d(0, 0, 0, 1), 1e-12));
 }
 
+TEST_F(NpzFiles, AnImuTCamInForwardRightDownAxesIsRebasedOntoTheVelocitiesAxes) {
+  // The same camera mounting given in x-forward, y-right, z-down IMU axes (as 03.npz gives it):
+  // camera x (right) along IMU +y, camera y (down) along IMU +z, the camera at (1.5, -0.1, 0.6).
+  auto entries = small_dataset();
+  entries["imu_T_cam"] = npy({0, 0, 1, 1.5, 1, 0, 0, -0.1, 0, 1, 0, 0.6, 0, 0, 0, 1}, "(4, 4)");
+  const auto path = write_npz("right_down.npz", entries);
+  const auto rebased = read_visual_inertial_npz(path);
+  const auto flu = read_visual_inertial_npz(write_npz("small.npz", small_dataset()));
+  EXPECT_TRUE(rebased.cam_T_imu.isApprox(flu.cam_T_imu, 1e-12)) << rebased.cam_T_imu << "\n\n" << flu.cam_T_imu;
+  const auto as_stored = read_visual_inertial_npz(path, {.rebase_forward_right_down_extrinsic = false});
+  EXPECT_TRUE((as_stored.cam_T_imu * Eigen::Vector4d(1.5, -0.1, 0.6, 1.0)).isApprox(Eigen::Vector4d(0, 0, 0, 1), 1e-12));
+}
+
 TEST_F(NpzFiles, ReadsTheOtherKeySpellingsAndTheCamTImuConvention) {
   auto entries = small_dataset();
   entries["rotational_velocity"] = entries["angular_velocity"];
@@ -325,6 +338,20 @@ TEST(VisualInertialNpz, TheCamTImuTranslationOfThe0027FilesIsTheCameraPosition) 
   std::printf("0027_clean median reprojection error: translation read as camera position %.2f px, as proper cam_T_imu %.2f px\n",
               as_position, as_proper);
   EXPECT_LT(as_position, as_proper);
+}
+
+TEST(VisualInertialNpz, The03ExtrinsicIsReadInTheAxesOfItsVelocities) {
+  // 03.npz's imu_T_cam has the camera's x (right) along the IMU's +y and its y (down) along +z:
+  // x-forward, y-right, z-down axes. Integrated in those axes its yaw rate turns the wrong way for
+  // the images; re-based onto x-forward, y-left, z-up (KITTI's OXTS) the landmarks reproject better.
+  const auto path = test::shared_data("ece276a/03.npz");
+  SEXTANT_REQUIRE_DATA(path);
+  const double rebased = median_reprojection_error(read_visual_inertial_npz(path));
+  const double as_stored =
+      median_reprojection_error(read_visual_inertial_npz(path, {.rebase_forward_right_down_extrinsic = false}));
+  std::printf("03 median reprojection error: extrinsic re-based onto the velocities' axes %.2f px, as stored %.2f px\n",
+              rebased, as_stored);
+  EXPECT_LT(rebased, as_stored);
 }
 
 }  // namespace

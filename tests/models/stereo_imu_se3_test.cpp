@@ -127,19 +127,34 @@ TEST(StereoImuSe3, PixelsAreThePinholeProjectionInBothCameras) {
   EXPECT_NEAR(z(0) - z(2), c.fx * c.baseline / 10.0, 1e-12);  // disparity
 }
 
-TEST(StereoImuSe3, PointsBehindTheCameraAndNonPositiveDisparitiesAreErrorsNotNaN) {
-  const auto camera = kitti_like_camera();
+TEST(StereoImuSe3, PointsBehindOrTooNearTheCameraAndNonPositiveDisparitiesAreErrorsNotNaN) {
+  auto camera = kitti_like_camera();
   const Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
-  // The camera looks along the IMU's +x: a point at x = -5 is behind it, one at x = 1 (the
-  // camera's own position) has depth 0.
-  for (const Eigen::Vector3d& m : {Eigen::Vector3d(-5.0, 0.0, 0.5), Eigen::Vector3d(1.0, 0.0, 0.5)}) {
+  // The camera looks along the IMU's +x from x = 1: a point at x = -5 is behind it, one at x = 1
+  // has depth 0, one at x = 1.001 is in front but nearer than the baseline (the default near
+  // plane), where its Jacobian (~fx x / depth^2) would be ~1e9 and swamp S in rounding.
+  ASSERT_GT(camera.calibration.baseline, 0.01);
+  for (const Eigen::Vector3d& m : {Eigen::Vector3d(-5.0, 0.0, 0.5), Eigen::Vector3d(1.0, 0.0, 0.5),
+                                   Eigen::Vector3d(1.001, 3.0, 0.5)}) {
     try {
       (void)camera.predict(T, m);
-      ADD_FAILURE() << "a point at depth <= 0 was predicted";
+      ADD_FAILURE() << "a point at depth " << m.x() - 1.0 << " m was predicted";
     } catch (const unobservable_error& e) {
-      EXPECT_NE(std::string(e.what()).find("behind the camera"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("behind or too near the camera"), std::string::npos) << e.what();
     }
   }
+  EXPECT_NO_THROW((void)camera.predict(T, Eigen::Vector3d(1.0 + 1.01 * camera.calibration.baseline, 0.0, 0.5)));
+  camera.min_depth = 0.01;  // a near plane set by hand
+  EXPECT_NO_THROW((void)camera.predict(T, Eigen::Vector3d(1.02, 0.0, 0.5)));
+  EXPECT_THROW((void)camera.predict(T, Eigen::Vector3d(1.005, 0.0, 0.5)), unobservable_error);
+  // Outside the field of view: 10 m ahead, 25 m to the side (bearing tangent 2.5 > 2).
+  try {
+    (void)camera.predict(T, Eigen::Vector3d(11.0, -25.0, 0.5));
+    ADD_FAILURE() << "a point 68 degrees off the optical axis was predicted";
+  } catch (const unobservable_error& e) {
+    EXPECT_NE(std::string(e.what()).find("outside the field of view"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW((void)camera.predict(T, Eigen::Vector3d(11.0, -15.0, 0.5)));  // tangent 1.5
   for (const double uR : {600.0, 610.0}) {  // disparity 0 and -10 px
     try {
       (void)camera.initialize(T, Eigen::Vector4d(600.0, 180.0, uR, 180.0));

@@ -14,33 +14,18 @@
 #include <mrpt/opengl/CSetOfObjects.h>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 
 #include "mrpt/mrpt_demo_data.hpp"
 #include "sextant/mrpt/scene.hpp"
+#include "support/run_program.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using sextant::testing::mrpt_demo;
 
-struct Result {
-  int exit_code;
-  std::string out, err;
-};
-
-Result run_program(const std::string& command_line, const fs::path& dir) {
-  const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string command = command_line + " >" + out.string() + " 2>" + err.string();
-  const int status = std::system(command.c_str());
-  auto slurp = [](const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  };
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-}
+using Result = sextant::test::ProgramResult;
+using sextant::test::run_program;
 
 Result run_runner(const std::string& arguments, const fs::path& dir) {
   return run_program(std::string(SEXTANT_RUN_EXE) + " " + arguments, dir);

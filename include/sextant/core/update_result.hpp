@@ -13,7 +13,8 @@ struct UpdateResult {
   std::size_t initialized = 0;           ///< new landmarks added to the map
   std::vector<LandmarkId> rejected;      ///< observations rejected by the Mahalanobis gate
   /// Observations the sensor model cannot use at the current estimate (unobservable_error: a point
-  /// behind the camera, a disparity <= 0), skipped one by one; a new landmark listed here is not added.
+  /// behind or too near the camera, outside its field of view, a disparity <= 0 or below the
+  /// smallest for a new landmark), skipped one by one; a new landmark listed here is not added.
   std::vector<LandmarkId> unusable;
 };
 

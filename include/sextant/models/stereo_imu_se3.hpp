@@ -8,6 +8,8 @@
 /// Derivations: docs/derivations/stereo_imu_se3.md.
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "sextant/core/error.hpp"
@@ -94,8 +96,8 @@ struct StereoCalibration {
 };
 
 /// z = (uL, vL, uR, vR) = M pi(cam_T_imu T^-1 m), pi(q) = q / q_3 (eqs. 24-25), pixel noise
-/// sigma on each coordinate. A point at or behind the camera (depth <= min_depth) cannot be
-/// predicted; a pixel pair with disparity uL - uR <= 0 cannot be triangulated: both throw
+/// sigma on each coordinate. A point outside the viewing frustum (at, behind or too near the
+/// camera, or at a bearing beyond max_bearing_tan) cannot be predicted; a pixel pair with disparity uL - uR <= 0 cannot be triangulated: both throw
 /// unobservable_error naming the problem (never a NaN), and the back-ends skip that observation
 /// alone and list it in UpdateResult::unusable.
 template <Se3Perturbation P>
@@ -106,12 +108,23 @@ struct StereoPixelsSe3Of {
   StereoCalibration calibration;
   Eigen::Matrix4d cam_T_imu = Eigen::Matrix4d::Identity();  ///< maps IMU-frame points into the left camera
   double pixel_sigma = 1.0;                                 ///< [px], each of uL, vL, uR, vR
-  double min_depth = 1e-3;                                  ///< [m] in front of the left camera
+  /// [m] the nearest depth a stereo pair is matched at; 0: one baseline. A point one baseline away
+  /// has a disparity of fx pixels, beyond what a rig with a typical field of view can match; an
+  /// estimate nearer than that is a wrong one, and its Jacobian (~fx x / depth^2) would swamp S in
+  /// rounding (docs/vislam_singular_innovation.md).
+  double min_depth = 0.0;
+  /// The widest bearing, |q1| / q3 and |q2| / q3, an estimate is predicted at (default: 63 degrees
+  /// off the optical axis, beyond any rectified pinhole image). An estimate out there while the
+  /// point is seen in the image is a wrong one: H grows like fx (q1 / q3)^2 and so does the
+  /// predicted spread, which lets a gate pass any residual into a meaningless linearization.
+  double max_bearing_tan = 2.0;
   /// [px] the smallest disparity uL - uR a new landmark is triangulated from. The depth's relative
   /// error is about sqrt(2) pixel_sigma / disparity; far beyond ~10% the linearized triangulation
   /// misstates the depth's distribution, so such points are left unusable as new landmarks.
   /// 0: every positive disparity.
   double min_disparity = 0.0;
+
+  double near_depth() const { return min_depth > 0.0 ? min_depth : calibration.baseline; }
 
   /// H_m = M dpi/dq(q) cam_T_imu T^-1 P^T (eq. 31). H_x = M dpi/dq(q) cam_T_imu d(T^-1 m)/dd with
   /// d(T^-1 m)/dd = -(T^-1 m)^odot for the body perturbation (eq. 41 with its sign) and
@@ -120,9 +133,13 @@ struct StereoPixelsSe3Of {
     const Eigen::Matrix4d x_inv = se3::inverse(x);
     const Eigen::Vector4d s = x_inv * m.homogeneous();  // the point in the IMU frame
     const Eigen::Vector4d q = cam_T_imu * s;
-    if (!(q(2) > min_depth))
-      throw unobservable_error("stereo camera: the landmark is at or behind the camera (depth " + std::to_string(q(2)) +
-                               " m)");
+    if (!(q(2) > near_depth()))
+      throw unobservable_error("stereo camera: the landmark is behind or too near the camera (depth " +
+                               std::to_string(q(2)) + " m, nearest " + std::to_string(near_depth()) + " m)");
+    if (!(std::max(std::abs(q(0)), std::abs(q(1))) <= max_bearing_tan * q(2)))
+      throw unobservable_error("stereo camera: the landmark is outside the field of view (bearing tangent " +
+                               std::to_string(std::max(std::abs(q(0)), std::abs(q(1))) / q(2)) + ", widest " +
+                               std::to_string(max_bearing_tan) + ")");
     const Eigen::Matrix4d M = calibration.stereo_matrix();
     const Eigen::Matrix4d M_dpi = M * projection_jacobian(q);
     MeasurementPrediction<4, 6, 3> out;

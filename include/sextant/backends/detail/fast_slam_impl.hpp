@@ -341,7 +341,7 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
   const std::size_t initialized = started[best_particle(t.particles)];
   normalize_and_resample(t);
   commit(std::move(t));
-  return {measurements.size() - initialized, initialized, {}};
+  return {measurements.size() - initialized, initialized, {}, {}};
 }
 
 /// Normalizes the log weights (log-sum-exp), keeps the weighted cloud as the pose estimate, and
