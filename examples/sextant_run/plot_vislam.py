@@ -3,7 +3,6 @@
 reference.tum) in the x-y plane and each back-end's landmark map (*_map.csv); one PNG per back-end
 with a map and one with all trajectories.
 Usage: plot_vislam.py <dir>"""
-import csv
 import glob
 import os
 import sys
@@ -11,32 +10,22 @@ import sys
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt
+import matplotlib.pyplot as plt  # noqa: E402
+
+from plot_run import read_csv, read_tum  # noqa: E402  (sextant-run's plot script, copied beside this one)
 
 
-def read_tum(path):
-    xs, ys = [], []
-    with open(path) as f:
-        for line in f:
-            if line.startswith("#") or not line.strip():
-                continue
-            v = line.split()
-            xs.append(float(v[1]))
-            ys.append(float(v[2]))
-    return xs, ys
-
-
-def read_map(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return [float(r["x"]) for r in rows], [float(r["y"]) for r in rows]
+def trajectory_xy(path):
+    """A TUM trajectory as two lists, x and y."""
+    points = read_tum(path)
+    return [p[0] for p in points], [p[1] for p in points]
 
 
 def main(directory):
-    trajectories = {os.path.basename(p)[: -len("_trajectory.tum")]: read_tum(p)
+    trajectories = {os.path.basename(p)[: -len("_trajectory.tum")]: trajectory_xy(p)
                     for p in sorted(glob.glob(os.path.join(directory, "*_trajectory.tum")))}
     reference = os.path.join(directory, "reference.tum")
-    ref = read_tum(reference) if os.path.exists(reference) else None
+    ref = trajectory_xy(reference) if os.path.exists(reference) else None
 
     fig, ax = plt.subplots(figsize=(8, 8))
     if ref:
@@ -54,7 +43,8 @@ def main(directory):
     for path in sorted(glob.glob(os.path.join(directory, "*_map.csv"))):
         key = os.path.basename(path)[: -len("_map.csv")]
         fig, ax = plt.subplots(figsize=(8, 8))
-        mx, my = read_map(path)
+        landmarks = read_csv(path)
+        mx, my = [r["x"] for r in landmarks], [r["y"] for r in landmarks]
         ax.scatter(mx, my, s=2, c="tab:green", label="landmarks (last in the state)")
         if ref:
             ax.plot(*ref, "k-", lw=1.5, label="reference")

@@ -117,6 +117,11 @@ inline double positive(double value, const std::string& text) {
   return value;
 }
 
+inline double non_negative(double value, const std::string& text) {
+  if (!(value >= 0.0)) throw invalid_input_error("'" + text + "' must be >= 0");
+  return value;
+}
+
 /// The value without a trailing `// comment` (MRPT's ini files use them) and surrounding blanks.
 inline std::string without_comment(std::string value) {
   if (const auto comment = value.find("//"); comment != std::string::npos) value.erase(comment);
@@ -197,11 +202,7 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"vislam", "pixel_sigma", "2", "px: stereo feature noise (.npz data)",
        [](RunnerConfig& c, const std::string& v) { c.vislam.pixel_sigma = positive(parse_number(v), v); }},
       {"vislam", "min_disparity", "2", "px: smallest disparity a new landmark is triangulated from (.npz data)",
-       [](RunnerConfig& c, const std::string& v) {
-         const double x = parse_number(v);
-         if (x < 0.0) throw invalid_input_error("'" + v + "' must be >= 0");
-         c.vislam.min_disparity = x;
-       }},
+       [](RunnerConfig& c, const std::string& v) { c.vislam.min_disparity = non_negative(parse_number(v), v); }},
       {"vislam", "max_landmarks", "150", "landmark pool capacity (EKF: <= 10 ms per frame on 03.npz)",
        [](RunnerConfig& c, const std::string& v) { c.vislam.pool.max_landmarks = parse_integer<std::size_t>(v, 1); }},
       {"vislam", "max_new_per_step", "20", "new landmarks per frame at most",

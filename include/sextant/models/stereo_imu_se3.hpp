@@ -97,9 +97,9 @@ struct StereoCalibration {
 
 /// z = (uL, vL, uR, vR) = M pi(cam_T_imu T^-1 m), pi(q) = q / q_3 (eqs. 24-25), pixel noise
 /// sigma on each coordinate. A point outside the viewing frustum (at, behind or too near the
-/// camera, or at a bearing beyond max_bearing_tan) cannot be predicted; a pixel pair with disparity uL - uR <= 0 cannot be triangulated: both throw
-/// unobservable_error naming the problem (never a NaN), and the back-ends skip that observation
-/// alone and list it in UpdateResult::unusable.
+/// camera, or at a bearing beyond max_bearing_tan) cannot be predicted; a pixel pair with
+/// disparity uL - uR <= 0 cannot be triangulated: both throw unobservable_error naming the problem
+/// (never a NaN), and the back-ends skip that observation alone and list it in UpdateResult::unusable.
 template <Se3Perturbation P>
 struct StereoPixelsSe3Of {
   using Landmark = Eigen::Vector3d;
@@ -126,6 +126,22 @@ struct StereoPixelsSe3Of {
 
   double near_depth() const { return min_depth > 0.0 ? min_depth : calibration.baseline; }
 
+  /// Whether a point q in the left camera's frame lies in the viewing frustum: beyond the near
+  /// plane and within the widest bearing. predict() throws for a point outside it; the simulator
+  /// does not observe one.
+  bool sees(const Eigen::Vector3d& q) const { return q.z() > near_depth() && bearing_tangent(q) <= max_bearing_tan; }
+
+  static double bearing_tangent(const Eigen::Vector3d& q) { return std::max(std::abs(q.x()), std::abs(q.y())) / q.z(); }
+
+  /// What keeps q out of the frustum, for the unobservable_error.
+  std::string why_unseen(const Eigen::Vector3d& q) const {
+    if (!(q.z() > near_depth()))
+      return "stereo camera: the landmark is behind or too near the camera (depth " + std::to_string(q.z()) +
+             " m, nearest " + std::to_string(near_depth()) + " m)";
+    return "stereo camera: the landmark is outside the field of view (bearing tangent " +
+           std::to_string(bearing_tangent(q)) + ", widest " + std::to_string(max_bearing_tan) + ")";
+  }
+
   /// H_m = M dpi/dq(q) cam_T_imu T^-1 P^T (eq. 31). H_x = M dpi/dq(q) cam_T_imu d(T^-1 m)/dd with
   /// d(T^-1 m)/dd = -(T^-1 m)^odot for the body perturbation (eq. 41 with its sign) and
   /// -T^-1 m^odot for the world perturbation.
@@ -133,13 +149,7 @@ struct StereoPixelsSe3Of {
     const Eigen::Matrix4d x_inv = se3::inverse(x);
     const Eigen::Vector4d s = x_inv * m.homogeneous();  // the point in the IMU frame
     const Eigen::Vector4d q = cam_T_imu * s;
-    if (!(q(2) > near_depth()))
-      throw unobservable_error("stereo camera: the landmark is behind or too near the camera (depth " +
-                               std::to_string(q(2)) + " m, nearest " + std::to_string(near_depth()) + " m)");
-    if (!(std::max(std::abs(q(0)), std::abs(q(1))) <= max_bearing_tan * q(2)))
-      throw unobservable_error("stereo camera: the landmark is outside the field of view (bearing tangent " +
-                               std::to_string(std::max(std::abs(q(0)), std::abs(q(1))) / q(2)) + ", widest " +
-                               std::to_string(max_bearing_tan) + ")");
+    if (!sees(q.head<3>())) throw unobservable_error(why_unseen(q.head<3>()));
     const Eigen::Matrix4d M = calibration.stereo_matrix();
     const Eigen::Matrix4d M_dpi = M * projection_jacobian(q);
     MeasurementPrediction<4, 6, 3> out;

@@ -116,8 +116,7 @@ inline std::vector<Observation<Eigen::Vector4d>> visible_pixels(const StereoViOp
   const Eigen::Matrix4d cam_T_world = sensor.cam_T_imu * se3::inverse(world_T_imu);
   for (const auto& [id, p] : points) {
     const Eigen::Vector3d q = (cam_T_world * p.homogeneous()).head<3>();
-    if (q.z() < std::max(1.0, sensor.near_depth()) || q.norm() > o.max_range) continue;
-    if (std::max(std::abs(q.x()), std::abs(q.y())) > sensor.max_bearing_tan * q.z()) continue;  // far outside the image
+    if (q.z() < 1.0 || q.norm() > o.max_range || !sensor.sees(q)) continue;
     const Eigen::Vector4d z = sensor.predict(world_T_imu, p).z;
     const bool inside = z(0) >= 0 && z(0) < o.image_width && z(2) >= 0 && z(2) < o.image_width && z(1) >= 0 &&
                         z(1) < o.image_height;
