@@ -1,6 +1,7 @@
 // sextant-run's MRCLAM part: every chosen back-end on one or all robots of a UTIAS MRCLAM data set
 // (--dataset mrclam:<dir>:<robot|all>), scored against Vicon, beside dead reckoning.
 #include <cmath>
+#include <sextant/eval/dead_reckoning.hpp>
 #include <sextant/io/mrclam_reader.hpp>
 
 #include "dataset_runner.hpp"
@@ -11,12 +12,9 @@ namespace {
 
 /// Root mean square of the position error of the controls integrated from the start pose.
 double dead_reckoning_rmse(const io::MrclamRun& data) {
-  Eigen::Vector3d x = data.prior.mean;
+  const auto x = eval::dead_reckoning(data.motion, data.prior.mean, data.steps);
   double sum = 0.0;
-  for (std::size_t k = 0; k < data.steps.size(); ++k) {
-    x = data.motion.predict(x, data.steps[k].control, data.steps[k].dt).x;
-    sum += (x.head<2>() - data.true_poses[k + 1].head<2>()).squaredNorm();
-  }
+  for (std::size_t k = 0; k < x.size(); ++k) sum += (x[k].head<2>() - data.true_poses[k + 1].head<2>()).squaredNorm();
   return std::sqrt(sum / static_cast<double>(data.steps.size()));
 }
 

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <limits>
 #include <optional>
+#include <sextant/eval/dead_reckoning.hpp>
 #include <sextant/eval/pooled_run.hpp>
 #include <sextant/io/csv_writer.hpp>
 #include <sextant/io/tum_writer.hpp>
@@ -54,13 +55,6 @@ struct ViRun {
   double rmse = std::nan(""), anees = std::nan("");
 };
 
-std::vector<Eigen::Matrix4d> dead_reckon(const Motion& motion, const Eigen::Matrix4d& start, const std::vector<Frame>& frames) {
-  std::vector<Eigen::Matrix4d> out;
-  Eigen::Matrix4d T = start;
-  for (const auto& f : frames) out.push_back(T = motion.predict(T, f.control, f.dt).x);
-  return out;
-}
-
 ViData simulated(const RunnerConfig& c) {
   const auto sim = sim::simulate_stereo_vi({.seed = c.vislam.seed, .num_steps = c.vislam.steps});
   ViData d{"stereo-vi", sim.motion, sim.sensor, sim.prior, sim.steps, {}, {}, true, "truth", sim.true_landmarks};
@@ -94,7 +88,7 @@ ViData from_npz(const std::string& path, const RunnerConfig& c) {
   if (const auto twin = clean_twin(path)) {
     const auto clean = io::read_visual_inertial_npz(twin->string());
     if (clean.steps.size() == data.steps.size()) {
-      d.reference = dead_reckon(d.motion, Eigen::Matrix4d::Identity(), clean.steps);
+      d.reference = eval::dead_reckoning(d.motion, Eigen::Matrix4d(Eigen::Matrix4d::Identity()), clean.steps);
       d.reference_label = "dead reckoning of " + twin->filename().string();
     }
   }
@@ -161,7 +155,7 @@ ViRun dead_reckoning_row(const ViData& d) {
   out.key = "dead_reckoning";
   out.label = "dead reckoning (IMU only)";
   const auto started = std::chrono::steady_clock::now();
-  out.means = dead_reckon(d.motion, d.prior.mean, d.frames);
+  out.means = eval::dead_reckoning(d.motion, d.prior.mean, d.frames);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return out;
 }

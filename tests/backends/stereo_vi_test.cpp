@@ -13,6 +13,7 @@
 #include "sextant/backends/graph_slam.hpp"
 #include "sextant/backends/seif_slam.hpp"
 #include "sextant/core/landmark_pool_policy.hpp"
+#include "sextant/eval/dead_reckoning.hpp"
 #include "sextant/eval/metrics.hpp"
 #include "sextant/eval/monte_carlo.hpp"
 #include "sextant/eval/pooled_run.hpp"
@@ -35,7 +36,7 @@ RunScores ekf_run(std::uint64_t seed) {
   Ekf ekf(data.motion, data.sensor, data.prior, {.first_estimate_jacobians = true});
   const auto run = eval::run_through_pool(ekf, data.steps, kPool, 1, [](std::size_t, const auto&) {});
   RunScores out;
-  Eigen::Matrix4d dead_reckoning = data.prior.mean;
+  const auto dead_reckoning = eval::dead_reckoning(data.motion, data.prior.mean, data.steps);
   const double steps = static_cast<double>(data.steps.size());
   for (std::size_t k = 0; k < data.steps.size(); ++k) {
     const auto& truth = data.true_poses[k + 1];
@@ -43,8 +44,7 @@ RunScores ekf_run(std::uint64_t seed) {
     const se3::Vector6d e = Se3Space::minus(truth, estimate.mean);
     out.anees += e.dot(estimate.cov.ldlt().solve(e)) / steps;
     out.rmse += (se3::translation(estimate.mean) - se3::translation(truth)).squaredNorm() / steps;
-    dead_reckoning = data.motion.predict(dead_reckoning, data.steps[k].control, data.steps[k].dt).x;
-    out.dead_reckoning_rmse += (se3::translation(dead_reckoning) - se3::translation(truth)).squaredNorm() / steps;
+    out.dead_reckoning_rmse += (se3::translation(dead_reckoning[k]) - se3::translation(truth)).squaredNorm() / steps;
   }
   out.rmse = std::sqrt(out.rmse);
   out.dead_reckoning_rmse = std::sqrt(out.dead_reckoning_rmse);

@@ -10,9 +10,9 @@
 #include <unordered_map>
 #include <vector>
 
+#include "sextant/core/chi_square.hpp"
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/gaussian.hpp"
-#include "sextant/core/chi_square.hpp"
 #include "sextant/core/innovation_gate.hpp"
 #include "sextant/core/persistent_array.hpp"
 #include "sextant/core/update_result.hpp"

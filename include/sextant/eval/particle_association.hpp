@@ -11,7 +11,7 @@
 #include <span>
 #include <vector>
 
-#include "sextant/core/error.hpp"
+#include "sextant/core/observation.hpp"
 #include "sextant/core/update_result.hpp"
 
 namespace sextant::eval {
