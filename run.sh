@@ -23,7 +23,8 @@ case "$mode" in
   main)
     configure -DSEXTANT_BUILD_TESTS=OFF -DSEXTANT_BUILD_BENCHMARKS=OFF
     targets=(sextant-run)
-    case " $* " in *globe*) targets+=(sextant-globe) ;; esac  # --dataset globe hands over to sextant-globe
+    case " $* " in *globe-stereo*|*stereo:*) targets+=(sextant-globe-stereo) ;;  # stereo images: sextant-globe-stereo
+                   *globe*) targets+=(sextant-globe) ;; esac  # --dataset globe hands over to sextant-globe
     case " $* " in *stereo-vi*|*.npz*) targets+=(sextant-vislam) ;; esac  # and stereo-vi / FILE.npz to sextant-vislam
     cmake --build "$build" -j"$jobs" --target "${targets[@]}"
     exec "$build/examples/sextant-run" "$@" ;;

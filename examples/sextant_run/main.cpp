@@ -2,7 +2,8 @@
 // truth, side by side. With no arguments: all back-ends on the ship Monte Carlo and on the kf-slam
 // demo rawlogs that Debian's mrpt-common installs. --dataset globe hands over to sextant-globe (the
 // thesis's 12D camera around a simulated globe), --dataset stereo-vi or FILE.npz to sextant-vislam
-// (visual-inertial SLAM on SE(3)): programs of their own so that the main job does not compile them.
+// (visual-inertial SLAM on SE(3)), --dataset globe-stereo or stereo:<dir> to sextant-globe-stereo
+// (stereo images through the OpenCV front-end): programs of their own so that the main job does not compile them.
 // See docs/runner.md.
 #include <algorithm>
 #include <cerrno>
@@ -81,14 +82,15 @@ bool wants_globe(const CliOptions& options) {
   return true;
 }
 
-/// --dataset stereo-vi and .npz files run in sextant-vislam (next to this program), all of them in one call.
-bool wants_vislam(const CliOptions& options) {
+/// Whether the data sets are `program`'s (is_its): they run there alone, all of them in one call,
+/// so a mixture with the others is an error. `what` names them for the message.
+bool wants(const CliOptions& options, bool (*is_its)(const std::string&), const char* what, const char* program) {
   const auto& d = options.datasets;
-  const auto count = std::count_if(d.begin(), d.end(), is_vislam_dataset);
+  const auto count = std::count_if(d.begin(), d.end(), is_its);
   if (count == 0) return false;
   if (static_cast<std::size_t>(count) != d.size())
-    throw invalid_input_error("--dataset stereo-vi and .npz files run alone (in the program sextant-vislam); give the "
-                              "other data sets in a second call");
+    throw invalid_input_error(std::string("--dataset ") + what + " run alone (in the program " + program +
+                              "); give the other data sets in a second call");
   return true;
 }
 
@@ -108,8 +110,11 @@ int main(int argc, char** argv) {
   return runner_main(argc, argv, "sextant-run",
                      "sextant-run: SLAM back-ends on the simulated ship and on MRPT rawlogs, side by side",
                      [argv](CliOptions& options) {
+                       if (wants(options, is_stereo_image_dataset, "globe-stereo and stereo:<dir>", "sextant-globe-stereo"))
+                         return hand_over_to("sextant-globe-stereo", argv);
                        if (wants_globe(options)) return hand_over_to("sextant-globe", argv);
-                       if (wants_vislam(options)) return hand_over_to("sextant-vislam", argv);
+                       if (wants(options, is_vislam_dataset, "stereo-vi and .npz files", "sextant-vislam"))
+                         return hand_over_to("sextant-vislam", argv);
                        const RunnerConfig config = load_runner_config(options);
                        const auto kinds = parse_backends(options.backends);
                        std::vector<TableRow> rows;

@@ -14,17 +14,12 @@
 #include <string>
 #include <vector>
 
-#include "dataset_runs.hpp"
+#include "globe_runs.hpp"
 #include "plot_script.hpp"
 #include "progress_bar.hpp"
 
 namespace sextant::runner {
-namespace {
 
-using Dataset = sim::GlobeCameraDataset;
-using Motion = EulerCamera12D;
-
-/// The simulator's options from the runner's [globe] settings; everything else at its default.
 sim::GlobeCameraOptions globe_options(const GlobeSettings& s) {
   sim::GlobeCameraOptions o;
   o.seed = s.seed;
@@ -33,6 +28,11 @@ sim::GlobeCameraOptions globe_options(const GlobeSettings& s) {
   o.max_features_per_frame = s.features_per_frame;
   return o;
 }
+
+namespace {
+
+using Dataset = sim::GlobeCameraDataset;
+using Motion = EulerCamera12D;
 using Sensor = PointInCamera3D;
 
 /// One back-end configuration's run on the globe, scored.
@@ -47,6 +47,13 @@ struct GlobeRun {
   std::vector<double> graph_update_position_mae;  ///< GraphSLAM: position MAE after each global update
 };
 
+/// The landmarks of `map` that have a true point (a rendered front-end may propose a landmark whose
+/// first keypoint lies off the globe: it has none and is not scored).
+std::vector<LandmarkEstimate<3>> with_truth(std::vector<LandmarkEstimate<3>> map, const Dataset& data) {
+  std::erase_if(map, [&](const LandmarkEstimate<3>& l) { return !data.true_landmarks.contains(l.id); });
+  return map;
+}
+
 template <class Backend>
 GlobeRun run_filter(Backend& backend, const Dataset& data, const RunnerConfig& c, std::string key, std::string label) {
   ProgressBar progress("globe: " + key, data.steps.size());
@@ -55,7 +62,7 @@ GlobeRun run_filter(Backend& backend, const Dataset& data, const RunnerConfig& c
   GlobeRun out;
   out.key = std::move(key);
   out.label = std::move(label);
-  out.map = backend.map();
+  out.map = with_truth(backend.map(), data);
   out.scores = eval::score_camera(run.means, run.poses, data.true_poses, out.map, data.true_landmarks);
   out.summary = eval::summarize_camera(out.scores);
   out.means = std::move(run.means);
@@ -90,6 +97,7 @@ GlobeRun run_graph(const Dataset& data, const RunnerConfig& c) {
     std::vector<Vector12d> means(graph.pose_means().begin() + 1, graph.pose_means().end());
     out.map.clear();
     for (const auto& [id, mean] : graph.landmark_means()) out.map.push_back({id, mean, Eigen::Matrix3d::Zero()});
+    out.map = with_truth(std::move(out.map), data);
     out.scores = eval::score_camera(means, std::vector<eval::SampledPose<Gaussian<Vector12d, 12>>>{}, data.true_poses,
                                     out.map, data.true_landmarks, false);
     out.summary = eval::summarize_camera(out.scores);
@@ -172,10 +180,10 @@ TableRow table_row(const GlobeRun& r, std::size_t steps) {
   return {"globe", r.key, r.label, s, 1, std::nullopt};
 }
 
-void write_globe_outputs(const RunOptions& options, const Dataset& data, const std::vector<GlobeRun>& runs,
-                         const RunnerConfig& c) {
+void write_globe_outputs(const RunOptions& options, const std::string& name, const Dataset& data,
+                         const std::vector<GlobeRun>& runs, const RunnerConfig& c) {
   if (options.out.empty()) return;
-  const auto dir = std::filesystem::path(options.out) / "globe";
+  const auto dir = std::filesystem::path(options.out) / name;
   std::filesystem::create_directories(dir);
   std::vector<io::TumPose> truth;
   for (std::size_t k = 1; k < data.true_poses.size(); ++k)
@@ -212,20 +220,15 @@ void write_globe_outputs(const RunOptions& options, const Dataset& data, const s
 
 }  // namespace
 
-std::vector<TableRow> run_globe(const RunOptions& options, const std::vector<BackendKind>& kinds,
-                                const RunnerConfig& config) {
-  const auto data = sim::simulate_globe_camera(globe_options(config.globe));
-  std::printf("\n== globe: the thesis's 12D camera around a simulated globe, %d steps, %zu points, %d features per "
-              "frame, pool Mmax = %zu, max_new = %zu; seed %llu\n",
-              config.globe.steps, data.true_landmarks.size(), config.globe.features_per_frame,
-              config.globe.pool.max_landmarks, config.globe.pool.max_new_per_step,
-              static_cast<unsigned long long>(config.globe.seed));
+std::vector<TableRow> run_globe_dataset(const RunOptions& options, const std::string& name, const sim::GlobeCameraDataset& data,
+                                        const std::vector<BackendKind>& kinds, const RunnerConfig& config) {
   const auto runs = run_backends(data, kinds, config);
   print_globe_header();
   std::vector<TableRow> rows;
   for (const auto& r : runs) {
     print_globe_row(r, data.steps.size());
     rows.push_back(table_row(r, data.steps.size()));
+    rows.back().dataset = name;
   }
   for (const auto& r : runs) {
     if (r.graph_update_position_mae.empty()) continue;
@@ -247,8 +250,19 @@ std::vector<TableRow> run_globe(const RunOptions& options, const std::vector<Bac
   } else {
     std::printf("-\n");
   }
-  write_globe_outputs(options, data, runs, config);
+  write_globe_outputs(options, name, data, runs, config);
   return rows;
+}
+
+std::vector<TableRow> run_globe(const RunOptions& options, const std::vector<BackendKind>& kinds,
+                                const RunnerConfig& config) {
+  const auto data = sim::simulate_globe_camera(globe_options(config.globe));
+  std::printf("\n== globe: the thesis's 12D camera around a simulated globe, %d steps, %zu points, %d features per "
+              "frame, pool Mmax = %zu, max_new = %zu; seed %llu\n",
+              config.globe.steps, data.true_landmarks.size(), config.globe.features_per_frame,
+              config.globe.pool.max_landmarks, config.globe.pool.max_new_per_step,
+              static_cast<unsigned long long>(config.globe.seed));
+  return run_globe_dataset(options, "globe", data, kinds, config);
 }
 
 }  // namespace sextant::runner

@@ -21,6 +21,7 @@ struct CliOptions {
   int runs = 0;
   std::string associate;  ///< overrides [association] method when set
   bool print_config = false;
+  std::string save_images;  ///< globe-stereo: write the rendered sequence here
   RunOptions output;
 };
 
@@ -30,7 +31,7 @@ inline void add_runner_options(CLI::App& app, CliOptions& options) {
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--dataset,-d", options.datasets,
-                 "ship | globe | stereo-vi | <file.npz> | mrpt-demos | <file.rawlog> | <file.txt> (iSAM/GTSAM planar text) | mrclam:<dir>:<robot 1-5|all> "
+                 "ship | globe | globe-stereo | stereo:<dir> | stereo-vi | <file.npz> | mrpt-demos | <file.rawlog> | <file.txt> (iSAM/GTSAM planar text) | mrclam:<dir>:<robot 1-5|all> "
                  "(repeatable; default: ship and the "
                  "MRPT kf-slam demos)");
   app.add_option("--config,-c", options.config, "ini file (MRPT CConfigFile) with [ship] [globe] [vislam] [rawlog] [ekf] [seif] [graph] "
@@ -42,12 +43,20 @@ inline void add_runner_options(CLI::App& app, CliOptions& options) {
   app.add_option("--runs", options.runs, "Monte Carlo runs on the ship (overrides [ship] runs)")->check(CLI::Range(1, 100000));
   app.add_flag("--plots", options.output.plots, "also write PNG plots of trajectory, map, error and NEES (needs --out or "
                                                 "writes to ./sextant-run-output)");
+  app.add_option("--save-images", options.save_images,
+                 "globe-stereo: also write the rendered stereo sequence to this directory (left/, right/, calib.yaml), "
+                 "which --dataset stereo:<dir> reads back");
   app.add_flag("--print-config", options.print_config, "print every config key with its default and meaning, then exit");
 }
 
 /// A data set of sextant-vislam: the simulated stereo car or a .npz file.
 inline bool is_vislam_dataset(const std::string& dataset) {
   return dataset == "stereo-vi" || std::filesystem::path(dataset).extension() == ".npz";
+}
+
+/// A data set of sextant-globe-stereo: the rendered globe or a stereo image directory.
+inline bool is_stereo_image_dataset(const std::string& dataset) {
+  return dataset == "globe-stereo" || dataset.rfind("stereo:", 0) == 0;
 }
 
 inline std::vector<BackendKind> parse_backends(const std::vector<std::string>& names) {

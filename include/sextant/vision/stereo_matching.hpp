@@ -5,8 +5,10 @@
 /// right feature picks the same left one back (mutual best).
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <limits>
 #include <opencv2/core.hpp>
+#include <span>
 #include <vector>
 
 #include "sextant/vision/features.hpp"
@@ -41,13 +43,36 @@ inline bool on_epipolar_segment(const Eigen::Vector2d& left, const Eigen::Vector
   return std::abs(left.y() - right.y()) <= o.max_row_difference && disparity > 0.0 && disparity <= o.max_disparity;
 }
 
+/// The keypoints of one image sorted by row, so that the candidates on an epipolar band are found
+/// by binary search instead of a scan of the whole image.
+class RowIndex {
+ public:
+  explicit RowIndex(const Features& f) : order_(f.keypoints.size()) {
+    for (std::size_t j = 0; j < order_.size(); ++j) order_[j] = static_cast<int>(j);
+    std::sort(order_.begin(), order_.end(),
+              [&](int a, int b) { return f.keypoints[static_cast<std::size_t>(a)].pt.y < f.keypoints[static_cast<std::size_t>(b)].pt.y; });
+    rows_.reserve(order_.size());
+    for (int j : order_) rows_.push_back(f.keypoints[static_cast<std::size_t>(j)].pt.y);
+  }
+  /// Keypoint indices with |row - v| <= tolerance.
+  std::span<const int> band(double v, double tolerance) const {
+    const auto lo = std::lower_bound(rows_.begin(), rows_.end(), v - tolerance);
+    const auto hi = std::upper_bound(lo, rows_.end(), v + tolerance);
+    return {order_.data() + (lo - rows_.begin()), static_cast<std::size_t>(hi - lo)};
+  }
+
+ private:
+  std::vector<int> order_;
+  std::vector<double> rows_;
+};
+
 /// For feature i of `from`, the best candidate of `to` that passes the ratio test, or -1.
-inline int best_partner(const Features& from, int i, const Features& to, const StereoMatchOptions& o, bool from_is_left,
-                        double& best_distance) {
+inline int best_partner(const Features& from, int i, const Features& to, const RowIndex& to_rows,
+                        const StereoMatchOptions& o, bool from_is_left, double& best_distance) {
   double best = std::numeric_limits<double>::infinity(), second = best;
   int best_j = -1;
   const Eigen::Vector2d p = pixel(from.keypoints[static_cast<std::size_t>(i)]);
-  for (int j = 0; j < static_cast<int>(to.keypoints.size()); ++j) {
+  for (const int j : to_rows.band(p.y(), o.max_row_difference)) {
     const Eigen::Vector2d q = pixel(to.keypoints[static_cast<std::size_t>(j)]);
     if (!(from_is_left ? on_epipolar_segment(p, q, o) : on_epipolar_segment(q, p, o))) continue;
     const double d = descriptor_distance(from.descriptors, i, to.descriptors, j);
@@ -70,10 +95,11 @@ inline int best_partner(const Features& from, int i, const Features& to, const S
 inline std::vector<StereoMatch> match_stereo(const Features& left, const Features& right, const StereoMatchOptions& o = {}) {
   std::vector<StereoMatch> out;
   if (left.keypoints.empty() || right.keypoints.empty()) return out;
+  const detail::RowIndex left_rows(left), right_rows(right);
   for (int i = 0; i < static_cast<int>(left.keypoints.size()); ++i) {
     double distance = 0.0, back_distance = 0.0;
-    const int j = detail::best_partner(left, i, right, o, true, distance);
-    if (j < 0 || detail::best_partner(right, j, left, o, false, back_distance) != i) continue;
+    const int j = detail::best_partner(left, i, right, right_rows, o, true, distance);
+    if (j < 0 || detail::best_partner(right, j, left, left_rows, o, false, back_distance) != i) continue;
     out.push_back({i, j, detail::pixel(left.keypoints[static_cast<std::size_t>(i)]),
                    detail::pixel(right.keypoints[static_cast<std::size_t>(j)]), distance});
   }

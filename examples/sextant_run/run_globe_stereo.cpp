@@ -1,0 +1,246 @@
+// sextant-globe-stereo's runs (issue 12): the globe rendered as a rectified stereo sequence
+// (--dataset globe-stereo) or a user's rectified stereo sequence (--dataset stereo:<dir>), through the
+// OpenCV front-end (AKAZE, row matching, triangulation, association gated by the EKF's prediction,
+// the landmark pool) and then every back-end on the observations it produced.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sextant/io/csv_writer.hpp>
+#include <sextant/io/tum_writer.hpp>
+#include <sextant/sim/globe_render.hpp>
+#include <sextant/vision/globe_association_truth.hpp>
+#include <sextant/vision/stereo_sequence.hpp>
+#include <sextant/vision/stereo_tracker.hpp>
+#include <string>
+#include <vector>
+
+#include "globe_runs.hpp"
+#include "globe_stereo_runs.hpp"
+#include "progress_bar.hpp"
+
+namespace sextant::runner {
+namespace {
+
+using Tracker = vision::StereoTracker<EulerCamera12D>;
+using Observations = std::vector<Observation<Eigen::Vector3d>>;
+
+/// Sums over the frames of a run: the front-end's figures and the time per stage.
+struct FrontEndTotals {
+  std::size_t frames = 0, left_keypoints = 0, stereo_matches = 0, observations = 0, associated = 0, created = 0;
+  vision::TrackerTimes times;
+  double render = 0.0;
+
+  void add(const vision::TrackedFrame& f) {
+    ++frames;
+    left_keypoints += f.left_keypoints;
+    stereo_matches += f.stereo_matches;
+    observations += f.observations.size();
+    for (bool is_new : f.is_new) ++(is_new ? created : associated);
+    times.detect += f.times.detect;
+    times.match += f.times.match;
+    times.triangulate += f.times.triangulate;
+    times.associate += f.times.associate;
+    times.backend += f.times.backend;
+  }
+};
+
+void print_front_end(const FrontEndTotals& t, const vision::GlobeAssociationTruth* truth) {
+  const double n = static_cast<double>(std::max<std::size_t>(t.frames, 1));
+  std::printf("front-end over %zu frames: %.0f left keypoints, %.0f stereo matches, %.1f observations per frame "
+              "(%.1f associated, %.1f proposed as new)",
+              t.frames, t.left_keypoints / n, t.stereo_matches / n, t.observations / n, t.associated / n, t.created / n);
+  if (truth)
+    std::printf("; association precision %.4f (%zu of %zu right against the rendering)", truth->precision(),
+                truth->right(), truth->associated());
+  std::printf("\n%-12s %9s %9s %11s %10s %12s %9s %10s\n", "ms/frame", "detect", "match", "triangulate", "associate",
+              "EKF back-end", "total", "frames/s");
+  const auto& s = t.times;
+  std::printf("%-12s %9.2f %9.2f %11.3f %10.2f %12.2f %9.2f %10.2f\n", "", 1e3 * s.detect / n, 1e3 * s.match / n,
+              1e3 * s.triangulate / n, 1e3 * s.associate / n, 1e3 * s.backend / n, 1e3 * s.total() / n,
+              n / std::max(s.total(), 1e-12));
+  if (t.render > 0.0) std::printf("(rendering, not part of the pipeline: %.1f ms per stereo pair)\n", 1e3 * t.render / n);
+}
+
+/// Every observation the front-end handed to the pool, one row each (the round-trip test compares these files).
+void write_observations(const std::filesystem::path& dir, const std::vector<Observations>& frames,
+                        const std::vector<std::vector<bool>>& is_new) {
+  std::filesystem::create_directories(dir);
+  io::CsvWriter csv((dir / "observations.csv").string(), {"step", "id", "x", "y", "z", "new"});
+  for (std::size_t k = 0; k < frames.size(); ++k)
+    for (std::size_t i = 0; i < frames[k].size(); ++i) {
+      const auto& o = frames[k][i];
+      csv.row({static_cast<double>(k), static_cast<double>(o.landmark_id), o.z.x(), o.z.y(),
+               o.z.z(), is_new[k][i] ? 1.0 : 0.0});
+    }
+}
+
+/// The README's picture: one rendered pair with the features the front-end handed on (green:
+/// associated with the map, orange: proposed as new) joined left to right; below, the EKF's map and
+/// trajectories seen from above (x-z) and from the side (x-y), the truth in white, the estimate in red.
+struct PictureFrame {
+  cv::Mat left, right;
+  vision::TrackedFrame tracked;
+};
+
+void draw_pipeline_picture(const std::filesystem::path& file, const PictureFrame& f, const std::vector<LandmarkEstimate<3>>& map,
+                           const std::vector<Vector12d>& truth, const std::vector<Vector12d>& estimate) {
+  const int w = f.left.cols, h = f.left.rows;
+  cv::Mat canvas(2 * h, 2 * w, CV_8UC3, cv::Scalar(30, 30, 30));
+  cv::cvtColor(f.left, canvas(cv::Rect(0, 0, w, h)), cv::COLOR_GRAY2BGR);
+  cv::cvtColor(f.right, canvas(cv::Rect(w, 0, w, h)), cv::COLOR_GRAY2BGR);
+  for (std::size_t i = 0; i < f.tracked.observed.size(); ++i) {
+    const auto& o = f.tracked.observed[i];
+    const cv::Scalar colour = f.tracked.is_new[i] ? cv::Scalar(0, 165, 255) : cv::Scalar(0, 220, 0);
+    const cv::Point l(static_cast<int>(o.left_px.x()), static_cast<int>(o.left_px.y()));
+    const cv::Point r(w + static_cast<int>(o.right_px.x()), static_cast<int>(o.right_px.y()));
+    cv::circle(canvas, l, 4, colour, 1, cv::LINE_AA);
+    cv::circle(canvas, r, 4, colour, 1, cv::LINE_AA);
+    cv::line(canvas, l, r, colour, 1, cv::LINE_AA);
+  }
+  const double scale = 0.85 * h;  // px per m: the orbit (0.45 m radius) fills the panel
+  auto panel = [&](int x0, int a, int b, const char* title) {
+    const cv::Point centre(x0 + w / 2, h + h / 2);
+    auto at = [&](const Eigen::Vector3d& p) {
+      return cv::Point(centre.x + static_cast<int>(scale * p(a)), centre.y + static_cast<int>(scale * p(b)));
+    };
+    for (const auto& l : map) cv::circle(canvas, at(l.mean), 1, cv::Scalar(255, 180, 60), cv::FILLED);
+    auto path = [&](const std::vector<Vector12d>& poses, const cv::Scalar& colour, int thickness = 1) {
+      for (std::size_t k = 1; k < poses.size(); ++k)
+        cv::line(canvas, at(poses[k - 1].head<3>()), at(poses[k].head<3>()), colour, thickness, cv::LINE_AA);
+    };
+    path(truth, cv::Scalar(255, 255, 255), 3);
+    path(estimate, cv::Scalar(60, 60, 255));
+    cv::putText(canvas, title, cv::Point(x0 + 10, h + 25), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(230, 230, 230), 1,
+                cv::LINE_AA);
+  };
+  panel(0, 0, 2, "from above (x-z): EKF map (blue), true path (white), EKF path (red)");
+  panel(w, 0, 1, "from the side (x-y)");
+  cv::putText(canvas, "left", cv::Point(10, 25), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(230, 230, 230), 1, cv::LINE_AA);
+  cv::putText(canvas, "right: green associated, orange new", cv::Point(w + 10, 25), cv::FONT_HERSHEY_SIMPLEX, 0.6,
+              cv::Scalar(230, 230, 230), 1, cv::LINE_AA);
+  if (!cv::imwrite(file.string(), canvas)) throw invalid_input_error(file.string() + ": cannot be written");
+}
+
+vision::StereoTrackerOptions tracker_options(const RunnerConfig& c) {
+  vision::StereoTrackerOptions o;
+  o.pool = c.globe.pool;
+  o.ekf = c.ekf;
+  o.association.max_observations = static_cast<std::size_t>(c.globe.features_per_frame);
+  return o;
+}
+
+cv::Mat as_mat(const sim::GrayImage& image) {
+  return cv::Mat(image.height, image.width, CV_8UC1, const_cast<std::uint8_t*>(image.pixels.data()));
+}
+
+vision::StereoCalibration calibration_of(const sim::GlobeCameraOptions& o, const Gaussian<Vector12d, 12>& prior) {
+  vision::StereoCalibration c;
+  c.K << o.stereo.focal_px, 0, 0.5 * o.image_width, 0, o.stereo.focal_px, 0.5 * o.image_height, 0, 0, 1;
+  c.baseline = o.stereo.baseline;
+  c.width = o.image_width;
+  c.height = o.image_height;
+  c.dt = o.dt;
+  c.initial_state = prior.mean;
+  c.initial_sigma = prior.cov.diagonal().cwiseSqrt();
+  return c;
+}
+
+}  // namespace
+
+std::vector<TableRow> run_globe_stereo(const RunOptions& options, const std::string& save_images,
+                                       const std::vector<BackendKind>& kinds, const RunnerConfig& config) {
+  const auto o = globe_options(config.globe);
+  const auto points = sim::simulate_globe_camera(o);
+  std::printf("\n== globe-stereo: the globe of --dataset globe rendered as %dx%d stereo pairs (seed %llu), %d frames "
+              "through the AKAZE front-end; pool Mmax = %zu, max_new = %zu, %d observations per frame at most\n",
+              o.image_width, o.image_height, static_cast<unsigned long long>(o.seed), o.num_steps,
+              config.globe.pool.max_landmarks, config.globe.pool.max_new_per_step, config.globe.features_per_frame);
+  const auto calibration = calibration_of(o, points.prior);
+  if (!save_images.empty()) vision::write_calibration(save_images, calibration);
+  Tracker tracker(points.motion, points.sensor, points.prior, calibration.rig(), o.image_width, o.image_height,
+                  tracker_options(config));
+  vision::GlobeAssociationTruth truth(o);
+  FrontEndTotals totals;
+  sim::GlobeCameraDataset stereo = points;
+  std::vector<Observations> frames;
+  std::vector<std::vector<bool>> is_new;
+  std::vector<Vector12d> ekf_means;
+  PictureFrame picture;
+  const std::size_t picture_step = std::min<std::size_t>(100, points.steps.size() - 1);
+  ProgressBar progress("globe-stereo: render + front-end", points.steps.size());
+  for (std::size_t k = 0; k < points.steps.size(); ++k) {
+    const Vector12d& x = points.true_poses[k + 1];
+    const auto start = std::chrono::steady_clock::now();
+    const auto images = sim::render_stereo(o, x);
+    totals.render += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const cv::Mat left = as_mat(images.left), right = as_mat(images.right);
+    if (!save_images.empty()) vision::write_stereo_pair(save_images, k, left, right);
+    const auto tracked = tracker.track(left, right, {}, points.steps[k].dt);
+    truth.score(x, tracked);
+    totals.add(tracked);
+    stereo.steps[k].observations = tracked.observations;
+    frames.push_back(tracked.observations);
+    is_new.push_back(tracked.is_new);
+    ekf_means.push_back(tracker.backend().pose().mean);
+    if (k == picture_step) picture = {left.clone(), right.clone(), tracked};
+    progress.advance();
+  }
+  stereo.true_landmarks = truth.true_landmarks();
+  print_front_end(totals, &truth);
+  if (!save_images.empty()) std::printf("wrote the rendered sequence to %s (left/, right/, calib.yaml)\n", save_images.c_str());
+  if (!options.out.empty()) write_observations(std::filesystem::path(options.out) / "globe-stereo", frames, is_new);
+  if (options.plots) {
+    const auto file = std::filesystem::path(options.out) / "globe-stereo" / "pipeline.png";
+    const std::vector<Vector12d> truth_path(points.true_poses.begin() + 1, points.true_poses.end());
+    draw_pipeline_picture(file, picture, tracker.backend().map(), truth_path, ekf_means);
+    std::printf("wrote %s (frame %zu with its features, the EKF's map and trajectory)\n", file.c_str(), picture_step);
+  }
+  std::printf("\nevery back-end on the front-end's observations:\n");
+  auto rows = run_globe_dataset(options, "globe-stereo", stereo, kinds, config);
+  std::printf("\nfor comparison, the point simulator (--dataset globe) on the same trajectory, EKF:\n");
+  const auto reference = run_globe_dataset(options, "globe", points, {BackendKind::ekf}, config);
+  rows.insert(rows.end(), reference.begin(), reference.end());
+  return rows;
+}
+
+std::vector<TableRow> run_stereo_directory(const RunOptions& options, const std::string& dir, const RunnerConfig& config) {
+  const vision::StereoSequence sequence(dir);
+  const auto& c = sequence.calibration();
+  PointInCamera3D sensor;
+  sensor.noise.focal_px = c.K(0, 0);
+  sensor.noise.baseline = c.baseline;
+  const auto prior = vision::initial_camera_estimate(c);
+  std::printf("\n== stereo:%s: %zu rectified pairs, %dx%d, f = %.1f px, baseline %.3f m, dt %.4f s; EKF tracking\n",
+              dir.c_str(), sequence.size(), c.width, c.height, c.K(0, 0), c.baseline, c.dt);
+  Tracker tracker(EulerCamera12D{}, sensor, prior, c.rig(), c.width, c.height, tracker_options(config));
+  FrontEndTotals totals;
+  std::vector<Observations> frames;
+  std::vector<std::vector<bool>> is_new;
+  std::vector<io::TumPose> trajectory;
+  ProgressBar progress("stereo: front-end", sequence.size());
+  for (std::size_t k = 0; k < sequence.size(); ++k) {
+    const auto [left, right] = sequence.load(k);
+    const auto tracked = tracker.track(left, right, {}, c.dt);
+    totals.add(tracked);
+    frames.push_back(tracked.observations);
+    is_new.push_back(tracked.is_new);
+    const Vector12d x = tracker.backend().pose().mean;
+    trajectory.push_back({c.dt * static_cast<double>(k + 1), x.head<3>(), Eigen::Quaterniond(euler_yxz::rotation(x.segment<3>(3)))});
+    progress.advance();
+  }
+  print_front_end(totals, nullptr);
+  std::printf("EKF at the end: %zu landmarks in the map; no ground truth with a stereo directory, so no error columns\n",
+              tracker.backend().landmark_ids().size());
+  if (!options.out.empty()) {
+    const auto out = std::filesystem::path(options.out) / "stereo";
+    write_observations(out, frames, is_new);
+    io::write_tum((out / "ekf_trajectory.tum").string(), trajectory);
+    std::printf("wrote observations.csv and ekf_trajectory.tum to %s\n", out.c_str());
+  }
+  return {};
+}
+
+}  // namespace sextant::runner

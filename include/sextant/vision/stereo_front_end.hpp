@@ -1,0 +1,112 @@
+#pragma once
+/// \file The image half of the stereo front-end: one rectified pair in, its stereo features out,
+/// each a 3D point in the left camera frame (the thesis's PointInCamera3D measurement) with its left
+/// keypoint and descriptor, strongest first; the time of each stage (the thesis's Figure 26 split).
+/// The left and right images are detected in parallel, each by its own detector.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <chrono>
+#include <future>
+#include <numeric>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "sextant/vision/features.hpp"
+#include "sextant/vision/stereo_matching.hpp"
+#include "sextant/vision/stereo_triangulation.hpp"
+
+namespace sextant::vision {
+
+struct FrontEndOptions {
+  DetectorOptions detector{};
+  StereoMatchOptions matching{};
+  bool parallel_detection = true;  ///< left and right on two threads
+};
+
+/// One stereo match as a measurement.
+struct StereoFeature {
+  Eigen::Vector2d left_px = Eigen::Vector2d::Zero(), right_px = Eigen::Vector2d::Zero();
+  float size = 0.0f, response = 0.0f;  ///< of the left keypoint
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< in the left camera frame (x right, y down, z forward)
+};
+
+/// Seconds per stage of one frame.
+struct FrontEndTimes {
+  double detect = 0.0, match = 0.0, triangulate = 0.0;
+};
+
+struct StereoFrame {
+  std::vector<StereoFeature> features;  ///< strongest left response first
+  cv::Mat descriptors;                  ///< row i: the left descriptor of features[i]
+  std::size_t left_keypoints = 0, right_keypoints = 0;
+  FrontEndTimes times;
+};
+
+class StereoFrontEnd {
+ public:
+  StereoFrontEnd(StereoRig rig, FrontEndOptions options = {})
+      : rig_(rig), options_(options), left_(make_detector(options.detector)), right_(make_detector(options.detector)) {}
+
+  const StereoRig& rig() const { return rig_; }
+  const FrontEndOptions& options() const { return options_; }
+
+  /// Detect, match along the rows, triangulate. Throws invalid_input_error for empty or non-8-bit
+  /// images or a left and right of different sizes; a pair without features gives an empty frame.
+  StereoFrame process(const cv::Mat& left, const cv::Mat& right) {
+    if (left.size() != right.size())
+      throw invalid_input_error("stereo front-end: left image " + size_text(left) + " and right image " +
+                                size_text(right) + " differ in size");
+    using Clock = std::chrono::steady_clock;
+    StereoFrame out;
+    auto start = Clock::now();
+    const auto [left_features, right_features] = detect_both(left, right);
+    out.left_keypoints = left_features.keypoints.size();
+    out.right_keypoints = right_features.keypoints.size();
+    auto lap = [&](double& seconds) {
+      const auto now = Clock::now();
+      seconds = std::chrono::duration<double>(now - start).count();
+      start = now;
+    };
+    lap(out.times.detect);
+    auto matches = match_stereo(left_features, right_features, options_.matching);
+    strongest_first(matches, left_features);
+    lap(out.times.match);
+    triangulate_matches(matches, left_features, out);
+    lap(out.times.triangulate);
+    return out;
+  }
+
+ private:
+  static std::string size_text(const cv::Mat& m) { return std::to_string(m.cols) + "x" + std::to_string(m.rows); }
+
+  std::pair<Features, Features> detect_both(const cv::Mat& left, const cv::Mat& right) {
+    if (!options_.parallel_detection) return {detect(left, *left_), detect(right, *right_)};
+    auto right_job = std::async(std::launch::async, [&] { return detect(right, *right_); });
+    Features l = detect(left, *left_);
+    return {std::move(l), right_job.get()};
+  }
+
+  static void strongest_first(std::vector<StereoMatch>& matches, const Features& left) {
+    std::stable_sort(matches.begin(), matches.end(), [&](const StereoMatch& a, const StereoMatch& b) {
+      return left.keypoints[static_cast<std::size_t>(a.left)].response > left.keypoints[static_cast<std::size_t>(b.left)].response;
+    });
+  }
+
+  void triangulate_matches(const std::vector<StereoMatch>& matches, const Features& left, StereoFrame& out) const {
+    out.features.reserve(matches.size());
+    out.descriptors.create(static_cast<int>(matches.size()), left.descriptors.cols, left.descriptors.type());
+    for (std::size_t i = 0; i < matches.size(); ++i) {
+      const StereoMatch& m = matches[i];
+      const cv::KeyPoint& k = left.keypoints[static_cast<std::size_t>(m.left)];
+      out.features.push_back({m.left_px, m.right_px, k.size, k.response, triangulate(rig_, m)});
+      left.descriptors.row(m.left).copyTo(out.descriptors.row(static_cast<int>(i)));
+    }
+  }
+
+  StereoRig rig_;
+  FrontEndOptions options_;
+  cv::Ptr<cv::Feature2D> left_, right_;
+};
+
+}  // namespace sextant::vision
