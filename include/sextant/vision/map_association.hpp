@@ -72,48 +72,29 @@ struct FrameAssociation {
   std::size_t gated_unmatched = 0;  ///< features inside a gate whose descriptors matched no landmark
 };
 
-namespace detail {
-
-/// The landmarks whose means lie in front of the camera and project inside the image: the only
-/// ones a feature can be (their joint marginal is all the gate needs).
-template <class Backend, class Sensor>
-std::vector<LandmarkId> landmarks_in_view(const Backend& backend, const Sensor& sensor, const StereoRig& rig, int width,
-                                          int height) {
-  const auto robot = eval::pose_mean_of(backend);
-  std::vector<LandmarkId> out;
-  for (const auto& landmark : backend.map()) {
-    Eigen::Vector3d q;
-    try {
-      q = sensor.predict(robot, landmark.mean).z;
-    } catch (const numerical_error&) {
-      continue;
-    }
-    if (!(q.z() > 0.0)) continue;
-    const double u = rig.cx + rig.focal_px * q.x() / q.z(), v = rig.cy + rig.focal_px * q.y() / q.z();
-    if (u >= 0.0 && u < width && v >= 0.0 && v < height) out.push_back(landmark.id);
-  }
-  return out;
-}
-
-}  // namespace detail
-
-/// The predicted measurement and innovation covariance of every landmark in view, each from the
+/// The predicted measurement and innovation covariance of every landmark whose mean lies in front
+/// of the camera and projects inside the image (the only ones a feature can be). S comes from the
 /// back-end's joint marginal of the robot and that landmark (EKF: a gather of O(1) blocks per
 /// landmark; the cross terms between landmarks, which only a joint test would need, are never
 /// formed). Landmarks the model cannot predict or whose S is not positive definite are left out.
 template <class Backend, class Sensor>
 std::vector<PredictedLandmark> predict_landmarks_in_view(const Backend& backend, const Sensor& sensor, const StereoRig& rig,
                                                          int width, int height) {
+  const auto robot = eval::pose_mean_of(backend);
   std::vector<PredictedLandmark> out;
-  for (const LandmarkId id : detail::landmarks_in_view(backend, sensor, rig, width, height)) {
+  for (const auto& landmark : backend.map()) {
     try {
-      const auto joint = backend.joint_marginal(std::span<const LandmarkId>(&id, 1));
-      const auto p = sensor.predict(joint.robot, joint.landmarks[0]);
+      const auto p = sensor.predict(robot, landmark.mean);
+      const Eigen::Vector3d& q = p.z;
+      if (!(q.z() > 0.0) || !q.allFinite()) continue;
+      const double u = rig.cx + rig.focal_px * q.x() / q.z(), v = rig.cy + rig.focal_px * q.y() / q.z();
+      if (!(u >= 0.0 && u < width && v >= 0.0 && v < height)) continue;
+      const auto joint = backend.joint_marginal(std::span<const LandmarkId>(&landmark.id, 1));
       const Eigen::Index a = joint.offset(0);
       const Eigen::Matrix3d S = innovation_cross_block(joint.cov, p.J_z_x, p.J_z_m, a, p.J_z_x, p.J_z_m, a) + p.Q;
       const Eigen::LLT<Eigen::Matrix3d> llt(S);
-      if (llt.info() != Eigen::Success || !p.z.allFinite()) continue;
-      out.push_back({id, p.z, llt.solve(Eigen::Matrix3d::Identity())});
+      if (llt.info() != Eigen::Success) continue;
+      out.push_back({landmark.id, q, llt.solve(Eigen::Matrix3d::Identity())});
     } catch (const numerical_error&) {
     }
   }
