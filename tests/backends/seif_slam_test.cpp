@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <limits>
+
 #include "sextant/backends/ekf_slam.hpp"
 #include "sextant/eval/metrics.hpp"
 #include "support/nees_bound.hpp"
@@ -128,6 +131,31 @@ TEST(SeifSlam, RemoveLandmarkMarginalizesWithoutChangingTheOtherMarginals) {
     EXPECT_LT((after.cov - estimate.cov).cwiseAbs().maxCoeff(), 1e-9) << estimate.id;
   }
   EXPECT_THROW(seif.remove_landmark(removed), unknown_landmark_error);
+}
+
+TEST(SeifSlam, ReportsTheStageTimesOfTheLastUpdateThatSucceeded) {
+  const auto data = sim::simulate_ship_2d({.seed = 10, .num_steps = 40});
+  Seif seif{data.motion, data.sensor, data.prior, {.max_active = 3}};
+  EXPECT_EQ(seif.last_update_times().measurement_s, 0.0);
+  for (const auto& step : data.steps) {
+    seif.predict(step.control, step.dt);
+    const auto start = std::chrono::steady_clock::now();
+    seif.update(step.observations);
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const auto& times = seif.last_update_times();
+    EXPECT_GE(times.measurement_s, 0.0);
+    EXPECT_GE(times.mean_recovery_s, 0.0);
+    EXPECT_GE(times.sparsification_s, 0.0);
+    EXPECT_LE(times.measurement_s + times.mean_recovery_s + times.sparsification_s, wall);
+  }
+  const SeifUpdateTimes before = seif.last_update_times();
+  EXPECT_GT(before.measurement_s + before.mean_recovery_s + before.sparsification_s, 0.0);
+  std::vector<Seif::ObservationType> bad = data.steps.back().observations;
+  ASSERT_FALSE(bad.empty());
+  bad.front().z.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(seif.update(bad), invalid_input_error);
+  EXPECT_EQ(seif.last_update_times().measurement_s, before.measurement_s) << "a failed update leaves them";
+  EXPECT_EQ(seif.last_update_times().sparsification_s, before.sparsification_s);
 }
 
 TEST(SeifSlam, RejectsNegativeOptions) {

@@ -4,6 +4,7 @@
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -43,6 +44,15 @@ struct SeifOptions {
   /// That costs one sparse factorization of Omega per update: with the gate on, an update is no
   /// longer constant time. 0 = off.
   double gate_probability = 0.0;
+};
+
+/// Wall time of one update's stages, as the thesis times them (§5.4, Tables 15-16): measurement
+/// (linearization, gate, information added, new landmarks), update of the state estimate (mean
+/// recovery) and sparsification (with the active set's bookkeeping).
+struct SeifUpdateTimes {
+  double measurement_s = 0.0;
+  double mean_recovery_s = 0.0;
+  double sparsification_s = 0.0;
 };
 
 /// SEIF-SLAM in error-state information form: Omega (block-sparse) and r = xi - Omega mu at the
@@ -111,6 +121,8 @@ class SeifSlam {
   Eigen::SparseMatrix<double> information_matrix() const { return info_.to_sparse(); }
   const SparseInformation<X, M>& information() const { return info_; }
   const SeifOptions& options() const { return options_; }
+  /// Stage times of the last update that succeeded (zeros before the first).
+  const SeifUpdateTimes& last_update_times() const { return last_update_times_; }
 
  private:
   using Linearized = LinearizedObservation<Z, X, M>;
@@ -179,6 +191,7 @@ class SeifSlam {
   Eigen::VectorXd landmark_means_;
   SparseInformation<X, M> info_;
   LandmarkPool pool_;
+  SeifUpdateTimes last_update_times_;
   std::vector<std::size_t> active_queue_;  ///< slots linked to the robot, most recently observed first
   std::uint64_t updates_ = 0;
   std::uint64_t revision_ = 0;

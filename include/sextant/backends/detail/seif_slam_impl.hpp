@@ -129,6 +129,10 @@ void SeifSlam<Motion, Sensor>::augment(const NewLandmark& landmark) {
 
 template <class Motion, class Sensor>
 UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
+  using Clock = std::chrono::steady_clock;
+  const auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+  auto stage_start = Clock::now();
+  SeifUpdateTimes times;
   require_valid_observations(observations);
   const auto [known, fresh] = split_known_and_new(pool_, observations);
   // Linearize everything first; the rest runs as one transaction, undone if any step throws.
@@ -158,15 +162,21 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
       augment(landmark);
       observed.push_back(pool_.size() - 1);
     }
+    times.measurement_s = seconds_since(stage_start);
+    stage_start = Clock::now();
     ++updates_;
     if (options_.exact_recovery_period > 0 && updates_ % static_cast<std::uint64_t>(options_.exact_recovery_period) == 0)
       recover_mean_exactly_in_transaction();
     else
       recover_mean_locally();
+    times.mean_recovery_s = seconds_since(stage_start);
+    stage_start = Clock::now();
     update_active_queue(observed);
     sparsify();
     require_factorizable_robot_and_active("SEIF update");
+    times.sparsification_s = seconds_since(stage_start);
   });
+  last_update_times_ = times;
   return result;
 }
 
