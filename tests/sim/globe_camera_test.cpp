@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <numbers>
+#include <set>
 
 #include "sextant/eval/metrics.hpp"
 
@@ -17,6 +18,25 @@ TEST(GlobeCamera, IsDeterministicPerSeed) {
   EXPECT_EQ(a.true_poses.back(), b.true_poses.back());
   EXPECT_EQ(a.steps.back().observations.back().z, b.steps.back().observations.back().z);
   EXPECT_NE(a.true_poses.back(), c.true_poses.back());
+}
+
+TEST(GlobeCamera, ResponseJitterChangesWhichPointsAreDetectedButNotTheMotion) {
+  const sim::GlobeCameraOptions steady{.seed = 3, .num_steps = 60, .num_points = 6000};
+  sim::GlobeCameraOptions jittered = steady;
+  jittered.response_jitter = 1.0;
+  const auto a = sim::simulate_globe_camera(steady), b = sim::simulate_globe_camera(jittered);
+  EXPECT_EQ(a.true_poses, b.true_poses) << "the jitter has its own random stream";
+  EXPECT_EQ(a.true_landmarks, b.true_landmarks);
+  const auto distinct_ids = [](const sim::GlobeCameraDataset& data) {
+    std::set<LandmarkId> ids;
+    for (const auto& step : data.steps)
+      for (const auto& observation : step.observations) ids.insert(observation.landmark_id);
+    return ids.size();
+  };
+  // Without jitter the strongest points repeat from frame to frame; with it the cut moves.
+  EXPECT_GT(distinct_ids(b), 2 * distinct_ids(a));
+  for (const auto& step : b.steps)
+    EXPECT_EQ(step.observations.size(), static_cast<std::size_t>(jittered.max_features_per_frame));
 }
 
 TEST(GlobeCamera, CirclesTheGlobeLookingAtItAndClosesTheLoopNearStep420) {

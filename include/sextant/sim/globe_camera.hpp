@@ -33,6 +33,11 @@ struct GlobeCameraOptions {
   double orbit_height = -0.10;   ///< m, camera height (y down: negative is above the equator)
   int image_width = 640, image_height = 480;  ///< px; principal point at the centre
   int max_features_per_frame = 120;  ///< the detector keeps the strongest responses
+  /// Log-normal frame-to-frame noise on each response (standard deviation of its logarithm): a real
+  /// detector's responses change with blur, lighting and viewpoint, so which features pass the cut
+  /// changes between frames and new ones keep entering the map (the thesis's real images, Figure 25).
+  /// 0 = the same strongest points every frame. Drawn from its own stream: it leaves the rest alone.
+  double response_jitter = 0.0;
   double border_px = 8.0;        ///< features nearer the image border are not detected
   StereoPointNoise stereo{};     ///< focal length, baseline, pixel noise
   EulerCamera12D motion{};       ///< the motion model and its process noise (also the truth's)
@@ -138,6 +143,8 @@ inline GlobeCameraDataset simulate_globe_camera(const GlobeCameraOptions& o) {
   std::vector<double> strength(data.true_landmarks.size());
   for (auto& s : strength) s = uniform(rng);
 
+  std::mt19937_64 jitter_rng(o.seed ^ 0x9e3779b97f4a7c15ULL);
+  std::normal_distribution<double> jitter(0.0, o.response_jitter);
   Vector12d x = detail::orbit_start(o);
   data.true_poses.push_back(x);
   Vector12d prior_variance;
@@ -156,6 +163,8 @@ inline GlobeCameraDataset simulate_globe_camera(const GlobeCameraOptions& o) {
     Step<GlobeCameraDataset::Control, Eigen::Vector3d> step;
     step.dt = o.dt;
     auto detections = detail::visible_points(o, x, data.true_landmarks, strength);
+    if (o.response_jitter > 0.0)
+      for (auto& d : detections) d.score *= std::exp(jitter(jitter_rng));
     const auto keep = std::min<std::size_t>(detections.size(), static_cast<std::size_t>(o.max_features_per_frame));
     std::partial_sort(detections.begin(), detections.begin() + static_cast<std::ptrdiff_t>(keep), detections.end(),
                       [](const auto& a, const auto& b) { return a.score > b.score; });
