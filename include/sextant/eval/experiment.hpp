@@ -38,6 +38,20 @@ struct RunSummary {
 };
 
 namespace detail {
+/// Length of the position error of `estimate` against `truth`: the leading `position_dim` entries of
+/// Space::minus (all of them for -1), or Space::position_error where the chart's tangent mixes the
+/// rotation into the position (Se2WorldSpace).
+template <class Space, class State>
+double position_error(const State& estimate, const State& truth, int position_dim) {
+  if constexpr (requires { Space::position_error(estimate, truth); })
+    return Space::position_error(estimate, truth).norm();
+  else {
+    const auto error = Space::minus(estimate, truth);
+    const int n = position_dim < 0 ? static_cast<int>(error.size()) : std::min<int>(position_dim, error.size());
+    return error.head(n).norm();
+  }
+}
+
 /// Errors after the best rigid alignment of `estimate` onto `truth` (points of dimension dim, 2 or
 /// 3, given as the leading entries of each vector); empty for other dimensions.
 template <class A, class B>
@@ -116,8 +130,7 @@ RunSummary<typename Backend::State> evaluate_run(Backend& backend, const Dataset
   for (std::size_t k = 0; k < record.steps.size(); ++k) {
     const auto& pose = record.steps[k].pose;
     const auto error = Space::minus(pose.mean, dataset.true_poses[k + 1]);
-    const int n = position_dim < 0 ? static_cast<int>(error.size()) : std::min<int>(position_dim, error.size());
-    out.pose_error.push_back(error.head(n).norm());
+    out.pose_error.push_back(detail::position_error<Space>(pose.mean, dataset.true_poses[k + 1], position_dim));
     out.pose_nees.push_back(nees_or_infinity(error, pose.cov));
     out.seconds.push_back(record.steps[k].seconds);
     out.trajectory.push_back(pose.mean);
@@ -145,8 +158,7 @@ RunSummary<typename Backend::State> evaluate_smoothed_run(Backend& backend, cons
   const auto trajectory = backend.trajectory();
   for (std::size_t k = 1; k < trajectory.size(); ++k) {
     const auto error = Space::minus(trajectory[k].mean, dataset.true_poses[k]);
-    const int n = position_dim < 0 ? static_cast<int>(error.size()) : std::min<int>(position_dim, error.size());
-    out.pose_error.push_back(error.head(n).norm());
+    out.pose_error.push_back(detail::position_error<Space>(trajectory[k].mean, dataset.true_poses[k], position_dim));
     out.pose_nees.push_back(nees_or_infinity(error, trajectory[k].cov));
     out.trajectory.push_back(trajectory[k].mean);
   }
