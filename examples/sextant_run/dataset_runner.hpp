@@ -31,19 +31,34 @@ void write_dataset_outputs(const RunOptions& options, const std::string& dataset
   run_plot_script("plot_run.py", dir, unit);
 }
 
-/// Runs the chosen back-ends on one data set, prints its part of the table, writes its outputs.
+/// The title and column header of one data set's part of the table.
 template <class Dataset>
-std::vector<TableRow> run_dataset(const RunOptions& options, const std::string& name, const Dataset& data,
-                                  const std::vector<BackendKind>& kinds, const RunnerConfig& config,
-                                  const Scoring& scoring, const char* unit) {
+void print_dataset_header(const std::string& name, const Dataset& data, const char* unit) {
   std::printf("\n== %s: %zu steps, %zu landmarks in the ground truth; errors in %s\n", name.c_str(), data.steps.size(),
               data.true_landmarks.size(), unit);
   print_header();
+}
+
+/// Runs the chosen back-ends on one data set, prints their rows, writes their outputs.
+template <class Dataset>
+std::vector<TableRow> run_dataset_rows(const RunOptions& options, const std::string& name, const Dataset& data,
+                                       const std::vector<BackendKind>& kinds, const RunnerConfig& config,
+                                       const Scoring& scoring, const char* unit) {
+  if (kinds.empty()) return {};
   std::vector<std::pair<BackendKind, BackendRun<Dataset>>> runs;
   auto rows = run_on_rawlog(name, data, kinds, config, scoring, runs);
   for (const auto& row : rows) print_row(row);
   write_dataset_outputs(options, name, data, runs, scoring, config, unit);
   return rows;
+}
+
+/// Runs the chosen back-ends on one data set, prints its part of the table, writes its outputs.
+template <class Dataset>
+std::vector<TableRow> run_dataset(const RunOptions& options, const std::string& name, const Dataset& data,
+                                  const std::vector<BackendKind>& kinds, const RunnerConfig& config,
+                                  const Scoring& scoring, const char* unit) {
+  print_dataset_header(name, data, unit);
+  return run_dataset_rows(options, name, data, kinds, config, scoring, unit);
 }
 
 }  // namespace sextant::runner

@@ -8,7 +8,9 @@
 #include <sextant/eval/particle_association.hpp>
 #include <sextant/eval/withheld_ids.hpp>
 #include <sextant/io/landmark_dataset.hpp>
+#include <sextant/models/se2_world_frame.hpp>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "progress_bar.hpp"
@@ -44,6 +46,13 @@ inline bool left_out(BackendKind kind, const RunnerConfig& c, const std::string&
   return true;
 }
 
+/// Whether the EKF linearizes at first estimates (RunnerConfig::ekf_first_estimates).
+template <class Motion>
+bool use_first_estimates(FirstEstimates choice) {
+  if (choice == FirstEstimates::automatic) return std::is_same_v<typename Motion::Space, Se2WorldSpace>;
+  return choice == FirstEstimates::on;
+}
+
 /// Runs one back-end over the data set; on_step(k) after every step.
 template <class Dataset, class OnStep>
 BackendRun<Dataset> run_backend(BackendKind kind, const Dataset& data, const RunnerConfig& c, const Scoring& scoring,
@@ -77,7 +86,9 @@ BackendRun<Dataset> run_backend(BackendKind kind, const Dataset& data, const Run
   };
   switch (kind) {
     case BackendKind::ekf: {
-      EkfSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, c.ekf);
+      EkfOptions o = c.ekf;
+      o.first_estimate_jacobians = use_first_estimates<Motion>(c.ekf_first_estimates);
+      EkfSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, o);
       run_filter(b);
       break;
     }

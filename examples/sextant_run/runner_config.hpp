@@ -63,17 +63,25 @@ struct AssociationSettings {
   AssociationOptions options;
 };
 
+/// [ekf] first_estimate_jacobians: automatic turns them on where the pose is perturbed in the world
+/// frame ([mrclam] filters_in_world_frame), the chart in which they keep the global pose
+/// unobservable; in the additive chart they would also need the motion Jacobian at first estimates,
+/// and alone they make the EKF worse (docs/results/mrclam.md).
+enum class FirstEstimates { automatic, on, off };
+
 struct RunnerConfig {
   sim::Ship2DOptions ship;
   int ship_runs = 10;
   mrpt_io::RawlogOptions rawlog;
   EkfOptions ekf;
+  FirstEstimates ekf_first_estimates = FirstEstimates::automatic;
   SeifOptions seif{.max_active = 8};
   GraphOptions graph;
   FastSlamOptions fastslam{.particles = 100, .resample_threshold = 0.1, .map_estimate = FastSlamMap::weighted_average};
   GlobeSettings globe;
   VislamSettings vislam;
   io::MrclamOptions mrclam;
+  bool mrclam_filters_in_world_frame = true;  ///< [mrclam] filters_in_world_frame
   AssociationSettings association;
   double scene_quantile = 3.0;
 };
@@ -261,6 +269,10 @@ inline const std::vector<ConfigKey>& config_keys() {
            throw invalid_input_error("'" + v + "' must be six non-negative numbers");
          std::copy(values.begin(), values.end(), c.mrclam.motion.alpha.begin());
        }},
+      {"mrclam", "filters_in_world_frame", "true",
+       "MRCLAM: EKF and SEIF perturb the pose in the world frame (with the EKF's first-estimate Jacobians: no "
+       "spurious heading information); GraphSLAM and FastSLAM keep the additive chart",
+       [](RunnerConfig& c, const std::string& v) { c.mrclam_filters_in_world_frame = parse_bool(v); }},
       {"association", "method", "known",
        "known (the data set's ids) | nn (nearest neighbour) | jcbb (joint compatibility): ids withheld and found by "
        "EKF and SEIF; FastSLAM associates per particle; GraphSLAM needs known ids",
@@ -282,6 +294,12 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) {
          c.ekf.covariance_update =
              parse_choice<CovarianceUpdate>(v, {{"symmetric", CovarianceUpdate::symmetric}, {"joseph", CovarianceUpdate::joseph}});
+       }},
+      {"ekf", "first_estimate_jacobians", "auto",
+       "auto (on where the pose is perturbed in the world frame: MRCLAM) | true | false",
+       [](RunnerConfig& c, const std::string& v) {
+         c.ekf_first_estimates = parse_choice<FirstEstimates>(
+             v, {{"auto", FirstEstimates::automatic}, {"true", FirstEstimates::on}, {"false", FirstEstimates::off}});
        }},
       {"ekf", "gate_probability", "0", "Mahalanobis gate: reject observations above this chi-square quantile; 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.ekf.gate_probability = parse_gate_probability(v); }},
