@@ -12,6 +12,7 @@
 #include <sextant/io/tum_writer.hpp>
 #include <sextant/sim/globe_render.hpp>
 #include <sextant/vision/globe_association_truth.hpp>
+#include <sextant/vision/gray_image_view.hpp>
 #include <sextant/vision/stereo_sequence.hpp>
 #include <sextant/vision/stereo_tracker.hpp>
 #include <string>
@@ -132,10 +133,6 @@ vision::StereoTrackerOptions tracker_options(const RunnerConfig& c) {
   return o;
 }
 
-cv::Mat as_mat(const sim::GrayImage& image) {
-  return cv::Mat(image.height, image.width, CV_8UC1, const_cast<std::uint8_t*>(image.pixels.data()));
-}
-
 vision::StereoCalibration calibration_of(const sim::GlobeCameraOptions& o, const Gaussian<Vector12d, 12>& prior) {
   vision::StereoCalibration c;
   c.K << o.stereo.focal_px, 0, 0.5 * o.image_width, 0, o.stereo.focal_px, 0.5 * o.image_height, 0, 0, 1;
@@ -176,7 +173,7 @@ std::vector<TableRow> run_globe_stereo(const RunOptions& options, const std::str
     const auto start = std::chrono::steady_clock::now();
     const auto images = sim::render_stereo(o, x);
     totals.render += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const cv::Mat left = as_mat(images.left), right = as_mat(images.right);
+    const cv::Mat left = vision::as_mat(images.left), right = vision::as_mat(images.right);
     if (!save_images.empty()) vision::write_stereo_pair(save_images, k, left, right);
     const auto tracked = tracker.track(left, right, {}, points.steps[k].dt);
     truth.score(x, tracked);

@@ -14,6 +14,7 @@
 #include "sextant/core/landmark_pool_policy.hpp"
 #include "sextant/sim/globe_render.hpp"
 #include "sextant/vision/globe_association_truth.hpp"
+#include "sextant/vision/gray_image_view.hpp"
 #include "sextant/vision/stereo_sequence.hpp"
 #include "sextant/vision/stereo_tracker.hpp"
 
@@ -24,10 +25,6 @@ using Tracker = StereoTracker<EulerCamera12D>;
 
 StereoRig rig_of(const sim::GlobeCameraOptions& o) {
   return {o.stereo.focal_px, 0.5 * o.image_width, 0.5 * o.image_height, o.stereo.baseline};
-}
-
-cv::Mat as_mat(const sim::GrayImage& image) {
-  return cv::Mat(image.height, image.width, CV_8UC1, const_cast<std::uint8_t*>(image.pixels.data())).clone();
 }
 
 /// A fresh directory under the test's temporary directory.

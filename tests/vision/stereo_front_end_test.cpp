@@ -12,6 +12,7 @@
 
 #include "sextant/sim/globe_render.hpp"
 #include "sextant/vision/features.hpp"
+#include "sextant/vision/gray_image_view.hpp"
 #include "sextant/vision/stereo_matching.hpp"
 #include "sextant/vision/stereo_triangulation.hpp"
 
@@ -48,10 +49,6 @@ struct RenderedPair {
     return (left_pixel(in_camera(*seen_right)) - m.left_px).norm() <= std::max(0.5 * left_size, 2.0);
   }
 };
-
-cv::Mat as_mat(const sim::GrayImage& image) {
-  return cv::Mat(image.height, image.width, CV_8UC1, const_cast<std::uint8_t*>(image.pixels.data())).clone();
-}
 
 TEST(StereoFrontEnd, StereoMatchesAlongTheOrbitAreRightAgainstTheRenderingsTruth) {
   const sim::GlobeCameraOptions options;
