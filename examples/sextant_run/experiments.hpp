@@ -46,7 +46,7 @@ inline bool left_out(BackendKind kind, const RunnerConfig& c, const std::string&
   return true;
 }
 
-/// Whether the EKF linearizes at first estimates (RunnerConfig::ekf_first_estimates).
+/// Whether a filter linearizes at first estimates (RunnerConfig::ekf_first_estimates, seif_first_estimates).
 template <class Motion>
 bool use_first_estimates(FirstEstimates choice) {
   if (choice == FirstEstimates::automatic) return std::is_same_v<typename Motion::Space, Se2WorldSpace>;
@@ -93,7 +93,9 @@ BackendRun<Dataset> run_backend(BackendKind kind, const Dataset& data, const Run
       break;
     }
     case BackendKind::seif: {
-      SeifSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, c.seif);
+      SeifOptions o = c.seif;
+      o.first_estimate_jacobians = use_first_estimates<Motion>(c.seif_first_estimates);
+      SeifSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, o);
       run_filter(b);
       break;
     }

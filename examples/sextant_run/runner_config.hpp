@@ -63,7 +63,7 @@ struct AssociationSettings {
   AssociationOptions options;
 };
 
-/// [ekf] first_estimate_jacobians: automatic turns them on where the pose is perturbed in the world
+/// [ekf] and [seif] first_estimate_jacobians: automatic turns them on where the pose is perturbed in the world
 /// frame ([mrclam] filters_in_world_frame), the chart in which they keep the global pose
 /// unobservable; in the additive chart they would also need the motion Jacobian at first estimates,
 /// and alone they make the EKF worse (docs/results/mrclam.md).
@@ -75,6 +75,7 @@ struct RunnerConfig {
   mrpt_io::RawlogOptions rawlog;
   EkfOptions ekf;
   FirstEstimates ekf_first_estimates = FirstEstimates::automatic;
+  FirstEstimates seif_first_estimates = FirstEstimates::automatic;
   SeifOptions seif{.max_active = 8};
   GraphOptions graph;
   FastSlamOptions fastslam{.particles = 100, .resample_threshold = 0.1, .map_estimate = FastSlamMap::weighted_average};
@@ -160,6 +161,11 @@ Enum parse_choice(const std::string& text, std::initializer_list<std::pair<const
     names += names.empty() ? name : std::string("|") + name;
   }
   throw invalid_input_error("'" + text + "' is not one of " + names);
+}
+
+inline FirstEstimates parse_first_estimates(const std::string& text) {
+  return parse_choice<FirstEstimates>(
+      text, {{"auto", FirstEstimates::automatic}, {"true", FirstEstimates::on}, {"false", FirstEstimates::off}});
 }
 
 }  // namespace detail
@@ -297,12 +303,12 @@ inline const std::vector<ConfigKey>& config_keys() {
        }},
       {"ekf", "first_estimate_jacobians", "auto",
        "auto (on where the pose is perturbed in the world frame: MRCLAM) | true | false",
-       [](RunnerConfig& c, const std::string& v) {
-         c.ekf_first_estimates = parse_choice<FirstEstimates>(
-             v, {{"auto", FirstEstimates::automatic}, {"true", FirstEstimates::on}, {"false", FirstEstimates::off}});
-       }},
+       [](RunnerConfig& c, const std::string& v) { c.ekf_first_estimates = parse_first_estimates(v); }},
       {"ekf", "gate_probability", "0", "Mahalanobis gate: reject observations above this chi-square quantile; 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.ekf.gate_probability = parse_gate_probability(v); }},
+      {"seif", "first_estimate_jacobians", "auto",
+       "auto (on where the pose is perturbed in the world frame: MRCLAM) | true | false",
+       [](RunnerConfig& c, const std::string& v) { c.seif_first_estimates = parse_first_estimates(v); }},
       {"seif", "gate_probability", "0",
        "Mahalanobis gate with the exact marginals (one factorization per update); 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.seif.gate_probability = parse_gate_probability(v); }},

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sextant/core/concepts.hpp"
+#include "sextant/core/first_estimates.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/innovation_gate.hpp"
 #include "sextant/core/joint_marginal.hpp"
@@ -125,7 +126,6 @@ class EkfSlam {
 
   /// The observations the model can use here; the others go to result.unusable.
   std::vector<Linearized> linearize(std::span<const ObservationType> known, UpdateResult& result) const;
-  void use_first_estimate_jacobians(Linearized& lin, std::size_t slot, const Measurement& z) const;
   Eigen::Matrix<double, Eigen::Dynamic, Z> cross_covariance(const Linearized& obs) const;
   /// H_i C: observation i's Jacobian applied to C (rows of the stacked state), from the robot and
   /// landmark rows only.
@@ -147,7 +147,7 @@ class EkfSlam {
   InnovationGate gate_;
   State x_;
   Eigen::VectorXd landmark_means_;
-  Eigen::VectorXd first_means_;  ///< each landmark's mean when it was added (first_estimate_jacobians)
+  FirstLandmarkMeans<M> first_means_;  ///< each landmark's mean when it was added (first_estimate_jacobians)
   GrowableSquareMatrix cov_;  ///< P; only its lower triangle is kept up to date
   LandmarkPool pool_;
 };

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "sextant/core/concepts.hpp"
+#include "sextant/core/first_estimates.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/innovation_gate.hpp"
 #include "sextant/core/joint_marginal.hpp"
@@ -44,6 +45,10 @@ struct SeifOptions {
   /// That costs one sparse factorization of Omega per update: with the gate on, an update is no
   /// longer constant time. 0 = off.
   double gate_probability = 0.0;
+  /// H of each landmark at its first estimate, the residual at the current one, as
+  /// EkfOptions::first_estimate_jacobians: with the pose perturbed in the world frame the information
+  /// added then never reaches the unobservable global pose. Off: the thesis's SEIF.
+  bool first_estimate_jacobians = false;
 };
 
 /// Wall time of one update's stages, as the thesis times them (§5.4, Tables 15-16): measurement
@@ -189,6 +194,7 @@ class SeifSlam {
   InnovationGate gate_;
   State x_;
   Eigen::VectorXd landmark_means_;
+  FirstLandmarkMeans<M> first_means_;  ///< each landmark's mean when it was added (first_estimate_jacobians)
   SparseInformation<X, M> info_;
   LandmarkPool pool_;
   SeifUpdateTimes last_update_times_;

@@ -50,7 +50,8 @@ UpdateResult EkfSlam<Motion, Sensor>::update(std::span<const ObservationType> ob
     return result;
   }
   const State x_before = x_;
-  const Eigen::VectorXd means_before = landmark_means_, first_before = first_means_;
+  const Eigen::VectorXd means_before = landmark_means_;
+  const FirstLandmarkMeans<M> first_before = first_means_;
   const GrowableSquareMatrix cov_before = cov_;
   try {
     const std::span<const ObservationType> all_known(known);
@@ -76,23 +77,11 @@ auto EkfSlam<Motion, Sensor>::linearize(std::span<const ObservationType> known, 
     auto lin = linearize_if_observable(sensor_, x_, landmark_mean(slot), observation.z, observation.landmark_id,
                                        offset_of(slot), result.unusable);
     if (!lin) continue;
-    if (options_.first_estimate_jacobians) use_first_estimate_jacobians(*lin, slot, observation.z);
+    if (options_.first_estimate_jacobians)
+      use_first_estimate_jacobians(sensor_, x_, Landmark(first_means_.at(slot)), observation.z, *lin);
     out.push_back(std::move(*lin));
   }
   return out;
-}
-
-/// H at the landmark's first estimate, the residual as it was (at the current estimate). Where the
-/// model cannot predict from the first estimate (behind the camera from here), H stays current.
-template <class Motion, class Sensor>
-void EkfSlam<Motion, Sensor>::use_first_estimate_jacobians(Linearized& lin, std::size_t slot,
-                                                           const Measurement& z) const {
-  std::vector<LandmarkId> unusable_from_first;
-  const auto first = linearize_if_observable(sensor_, x_, Landmark(first_means_.template segment<M>(M * slot)), z,
-                                             lin.id, lin.offset, unusable_from_first);
-  if (!first) return;
-  lin.J_z_x = first->J_z_x;
-  lin.J_z_m = first->J_z_m;
 }
 
 /// P H_i^T for one observation, from the robot and landmark column blocks only: O(n).
@@ -259,8 +248,7 @@ void EkfSlam<Motion, Sensor>::augment(LandmarkId id, const Init& init) {
       symmetrized(init.J_m_x * P_xx * init.J_m_x.transpose() + init.J_m_z * init.Q * init.J_m_z.transpose());
   landmark_means_.conservativeResize(landmark_means_.size() + M);
   landmark_means_.template tail<M>() = init.m;
-  first_means_.conservativeResize(first_means_.size() + M);
-  first_means_.template tail<M>() = init.m;
+  first_means_.append(init.m);
 }
 
 /// Marginalization in moment form: drop the landmark's rows and columns (thesis §4.2.2).
@@ -272,8 +260,7 @@ void EkfSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
   cov_.remove_block_by_moving_last(offset_of(removal.freed_slot), M);
   landmark_means_.template segment<M>(M * removal.freed_slot) = landmark_means_.template segment<M>(M * removal.last_slot);
   landmark_means_.conservativeResize(landmark_means_.size() - M);
-  first_means_.template segment<M>(M * removal.freed_slot) = first_means_.template segment<M>(M * removal.last_slot);
-  first_means_.conservativeResize(first_means_.size() - M);
+  first_means_.move_last_into(removal.freed_slot);
 }
 
 template <class Motion, class Sensor>

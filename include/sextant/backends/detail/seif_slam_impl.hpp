@@ -68,15 +68,19 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   });
 }
 
-/// H^T Q^-1 H and H^T Q^-1 nu of one observation, by blocks (thesis eqs. 29-30).
+/// One observation linearized at the current estimate (H at the first estimate if so configured).
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::linearize(const ObservationType& observation, std::vector<LandmarkId>& unusable) const
     -> std::optional<Linearized> {
   const std::size_t slot = pool_.slot(observation.landmark_id);
-  return linearize_if_observable(sensor_, x_, landmark_mean(slot), observation.z, observation.landmark_id,
-                                 offset_of(slot), unusable);
+  auto lin = linearize_if_observable(sensor_, x_, landmark_mean(slot), observation.z, observation.landmark_id,
+                                     offset_of(slot), unusable);
+  if (lin && options_.first_estimate_jacobians)
+    use_first_estimate_jacobians(sensor_, x_, Landmark(first_means_.at(slot)), observation.z, *lin);
+  return lin;
 }
 
+/// H^T Q^-1 H and H^T Q^-1 nu of one observation, by blocks (thesis eqs. 29-30).
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::measurement_information(const Linearized& lin) const -> MeasurementInformation {
   const auto llt = cholesky_or_throw(lin.Q, "measurement noise Q of landmark " + std::to_string(lin.id));
@@ -122,6 +126,7 @@ void SeifSlam<Motion, Sensor>::augment(const NewLandmark& landmark) {
   info_.append_landmark();
   landmark_means_.conservativeResize(landmark_means_.size() + M);
   landmark_means_.template tail<M>() = landmark.mean;
+  first_means_.append(landmark.mean);
   info_.robot() += landmark.xx;
   info_.add_to_robot_link(slot, landmark.xm);
   info_.diagonal(slot) = landmark.mm;
@@ -222,6 +227,7 @@ void SeifSlam<Motion, Sensor>::atomically(Step step) {
     while (pool_.size() > undo.landmarks) pool_.remove(pool_.id_at(pool_.size() - 1));
     if (undo.all_means) landmark_means_ = std::move(*undo.all_means);
     landmark_means_.conservativeResize(M * static_cast<Eigen::Index>(undo.landmarks));
+    first_means_.truncate(undo.landmarks);
     for (auto it = undo.means.rbegin(); it != undo.means.rend(); ++it)  // oldest saved value last
       landmark_means_.template segment<M>(M * it->first) = it->second;
     x_ = undo.x;
@@ -433,6 +439,7 @@ void SeifSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
   const auto removal = pool_.remove(id);
   landmark_means_.template segment<M>(M * removal.freed_slot) = landmark_means_.template segment<M>(M * removal.last_slot);
   landmark_means_.conservativeResize(landmark_means_.size() - M);
+  first_means_.move_last_into(removal.freed_slot);
   std::vector<std::size_t> queue;
   for (std::size_t s : active_queue_)
     if (s != removal.freed_slot) queue.push_back(s == removal.last_slot ? removal.freed_slot : s);
