@@ -16,6 +16,7 @@
 #include <sextant/backends/graph_slam.hpp>
 #include <sextant/backends/seif_slam.hpp>
 #include <sextant/core/landmark_pool_policy.hpp>
+#include <sextant/core/selected_inverse.hpp>
 #include <sextant/sim/globe_camera.hpp>
 
 namespace {
@@ -135,6 +136,32 @@ void BM_GlobeGraphOneGlobalUpdate(benchmark::State& state) {
   state.counters["landmarks"] = static_cast<double>(graph.num_landmarks());
 }
 
+/// GraphSLAM's marginals on the default globe (500 steps, 120 features a frame, Mmax = 1000) cut
+/// after range(0) steps: the information matrix at the optimum, inverted by each method of
+/// core/selected_inverse.hpp (range(1): 0 sparse Takahashi, 1 dense). Counters: the predicted work
+/// of each (lookups sum_j c_j^2 and flops 2/3 n^3), whose time ratio calibrates the automatic choice.
+void BM_GlobeGraphMarginals(benchmark::State& state) {
+  const auto steps = static_cast<int>(state.range(0));
+  const auto data = sim::simulate_globe_camera({.seed = 1, .num_steps = steps});
+  GraphSlam<EulerCamera12D, PointInCamera3D> graph(data.motion, data.sensor, data.prior, {.window = 50});
+  LandmarkPoolPolicy policy({.max_landmarks = 1000, .max_new_per_step = 50});
+  for (std::size_t k = 0; k < data.steps.size(); ++k) {
+    graph.predict(data.steps[k].control, data.steps[k].dt);
+    update_through_pool(graph, policy, std::span<const Obs>(data.steps[k].observations), k);
+  }
+  graph.optimize();
+  const Eigen::SparseMatrix<double> A = graph.information_matrix();
+  const auto method = state.range(1) ? SelectedInverse::Method::dense : SelectedInverse::Method::sparse;
+  for (auto _ : state) benchmark::DoNotOptimize(SelectedInverse(A, method).block(0, 12));
+  double lookups = 0;
+  for (Eigen::Index c : SelectedInverse::factor_column_counts(A)) lookups += static_cast<double>(c) * static_cast<double>(c);
+  const double n = static_cast<double>(A.rows());
+  state.counters["n"] = n;
+  state.counters["lookups"] = lookups;
+  state.counters["dense_flops"] = 2.0 / 3.0 * n * n * n;
+  state.counters["automatic_is_dense"] = SelectedInverse(A).method() == SelectedInverse::Method::dense;
+}
+
 /// EKF at the end of the run: the last step's observations (all known) as one update, against an
 /// Eigen product of the covariance correction's shape, (n x k)(k x n), timed right after. Flops: the
 /// correction updates the lower triangle of P by a rank-k product, n (n + 1) k; the product 2 n^2 k.
@@ -185,4 +212,9 @@ BENCHMARK(BM_GlobeEkf120Steps)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GlobeEkfUpdateAtFinalSize)->Iterations(3)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GlobeSeif120Steps)->Arg(150)->Arg(250)->Arg(1000)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GlobeGraphOneGlobalUpdate)->Iterations(3)->Unit(benchmark::kSecond);
+BENCHMARK(BM_GlobeGraphMarginals)
+    ->ArgsProduct({{30, 60, 100}, {0, 1}})
+    ->Args({500, 1})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 BENCHMARK_MAIN();

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Plots of sextant-run's globe outputs: position and rotation error over time per back-end, and the
-landmark pool's bookkeeping (in pool, added, evicted per step; the thesis's Figures 22 and 25).
+"""Plots of sextant-run's globe outputs: position and rotation error over time per back-end, their NEES
+at the sampled steps against the 95% bound (3 dof), and the landmark pool's bookkeeping (in pool,
+added, evicted per step; the thesis's Figures 22 and 25).
 Usage: plot_globe.py <dir with *_steps.csv>"""
 import csv
 import pathlib
@@ -18,22 +19,36 @@ def read(path):
     return {key: [float(r[key]) for r in rows] for key in rows[0]} if rows else {}
 
 
+def series_over_steps(runs, columns, ylabels, path, scale=(1.0, 1.0), log=False, bound=None):
+    """Two panels sharing the step axis: columns[0] and columns[1] of every run."""
+    fig, axes = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
+    for key, run in runs.items():
+        for axis, column, factor in zip(axes, columns, scale):
+            plot = axis.semilogy if log else axis.plot
+            plot(run["step"], [factor * v for v in run[column]], label=key, linewidth=0.8)
+    for axis, ylabel in zip(axes, ylabels):
+        axis.set_ylabel(ylabel)
+        if bound is not None:
+            axis.axhline(bound, color="black", linestyle="--", linewidth=0.8, label="95% bound, 3 dof")
+    axes[1].set_xlabel("step")
+    axes[0].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
 def main():
     directory = pathlib.Path(sys.argv[1])
     runs = {p.name[: -len("_steps.csv")]: read(p) for p in sorted(directory.glob("*_steps.csv"))}
     runs = {k: v for k, v in runs.items() if v}
     if not runs:
         sys.exit(f"{directory}: no *_steps.csv")
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
-    for key, run in runs.items():
-        top.plot(run["step"], [1e3 * e for e in run["position_error"]], label=key, linewidth=0.8)
-        bottom.plot(run["step"], run["rotation_error"], label=key, linewidth=0.8)
-    top.set_ylabel("position error [mm]")
-    bottom.set_ylabel("rotation error [rad]")
-    bottom.set_xlabel("step")
-    top.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(directory / "errors.png", dpi=120)
+    series_over_steps(runs, ("position_error", "rotation_error"), ("position error [mm]", "rotation error [rad]"),
+                      directory / "errors.png", scale=(1e3, 1.0))
+    nees = {p.name[: -len("_nees.csv")]: read(p) for p in sorted(directory.glob("*_nees.csv"))}
+    nees = {k: v for k, v in nees.items() if v}
+    if nees:
+        series_over_steps(nees, ("position_nees", "rotation_nees"), ("position NEES", "rotation-vector NEES"),
+                          directory / "nees.png", log=True, bound=7.81)
 
     key, run = next(iter(runs.items()))
     fig, ax = plt.subplots(figsize=(9, 4))

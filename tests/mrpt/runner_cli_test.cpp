@@ -3,6 +3,7 @@
 // non-zero exit and one line naming the file and the problem.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -125,6 +126,21 @@ TEST_F(RunnerCli, GlobeRunsEveryBackEndThroughThePoolAndWritesBookkeepingAndScen
   ASSERT_TRUE(scene.loadFromFile((out / "globe" / "seifall.3Dscene").string()));
   EXPECT_TRUE(scene.getByName(sextant::mrpt_io::scene_names::true_landmarks));
   EXPECT_TRUE(fs::exists(out / "globe" / "graph_trajectory.tum"));
+  // GraphSLAM's NEES from its smoothed marginals, at the filters' sampled steps (every 10th).
+  std::ifstream nees(out / "globe" / "graph_nees.csv");
+  std::getline(nees, line);
+  EXPECT_EQ(line, "step,position_nees,rotation_nees");
+  std::vector<double> steps;
+  while (std::getline(nees, line)) {
+    std::vector<double> v;
+    std::stringstream fields(line);
+    for (std::string f; std::getline(fields, f, ',');) v.push_back(std::stod(f));
+    ASSERT_EQ(v.size(), 3u);
+    EXPECT_TRUE(std::isfinite(v[1]) && v[1] >= 0.0 && std::isfinite(v[2]) && v[2] >= 0.0) << line;
+    steps.push_back(v[0]);
+  }
+  EXPECT_EQ(steps, (std::vector<double>{10, 20, 30, 40, 50, 60}));
+  EXPECT_NE(r.out.find("GraphSLAM NEES: smoothed marginals"), std::string::npos) << r.out;
 }
 
 TEST_F(RunnerCli, GlobeRunsAloneInItsOwnProgram) {

@@ -1,11 +1,18 @@
 #pragma once
-/// \file Entries of the inverse of a sparse SPD matrix on the pattern of its Cholesky factor
-/// (Takahashi's selected inversion): every marginal covariance block of a SLAM problem from one
-/// sparse LDL^T factorization, without forming the dense inverse.
+/// \file Entries of the inverse of a sparse SPD matrix: every marginal covariance block of a SLAM
+/// problem from one factorization. While the Cholesky factor stays sparse, Takahashi's selected
+/// inversion on the factor's pattern (no dense inverse is formed); when it fills in (visual SLAM:
+/// every landmark seen from ~100 poses couples those poses) a dense blocked inverse factor, whose
+/// BLAS-3 kernels beat the sparse recursion's scattered look-ups by far. The choice is made before
+/// any numeric factorization, from the factor's column counts (docs/design_notes.md).
 
+#include <Eigen/Cholesky>
+#include <Eigen/Dense>
+#include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,38 +23,143 @@ namespace sextant {
 class SelectedInverse {
  public:
   using SparseMatrix = Eigen::SparseMatrix<double>;
+  enum class Method { automatic, sparse, dense };
 
-  /// Factorizes A (symmetric positive definite; full or lower storage) with a fill-reducing
-  /// ordering, then computes Z = A^-1 on the pattern of L. Throws numerical_error if A is not PD.
-  explicit SelectedInverse(const SparseMatrix& A) : ldlt_(A) {
-    if (ldlt_.info() != Eigen::Success) throw numerical_error("matrix to invert is not positive definite");
-    const Eigen::VectorXd d = ldlt_.vectorD();
-    if ((d.array() <= 0.0).any()) throw numerical_error("matrix to invert is not positive definite");
-    compute(d);
+  /// Largest dimension the dense method takes on its own (one n x n matrix of doubles is 2 GiB here).
+  static constexpr Eigen::Index dense_limit = 16384;
+  /// Cost of one of the sparse method's look-ups (a binary search in a column of the factor, with
+  /// the sparse factorization's share) in flops of the dense method: 125-144 measured on GraphSLAM's
+  /// globe information matrices of 882-2136 dimensions (BM_GlobeGraphMarginals, docs/benchmarks.md),
+  /// rounded down so that a close call keeps the sparse method and its smaller memory.
+  static constexpr double lookup_cost_in_flops = 100.0;
+
+  /// Factorizes A (symmetric positive definite; full or lower storage). automatic takes the
+  /// method with the smaller predicted work (dense only up to dense_limit). Throws numerical_error
+  /// if A is not positive definite.
+  explicit SelectedInverse(const SparseMatrix& A, Method method = Method::automatic) {
+    if (A.rows() != A.cols()) throw invalid_input_error("selected inverse of a non-square matrix");
+    if (method == Method::automatic) method = prefers_dense(A) ? Method::dense : Method::sparse;
+    method_ = method;
+    if (method == Method::dense)
+      invert_densely(A);
+    else
+      invert_sparsely(A);
   }
 
-  Eigen::Index rows() const { return static_cast<Eigen::Index>(diagonal_.size()); }
+  Eigen::Index rows() const { return n_; }
+  /// The method used (never automatic).
+  Method method() const { return method_; }
 
-  /// (A^-1)(r, c) in the original ordering; (r, c) must lie in the pattern of the factor, which
-  /// holds for every entry stored in A. Store whole blocks (explicit zeros included) so that every
-  /// marginal block can be read; throws numerical_error for an entry outside the pattern.
+  /// (A^-1)(r, c) in the original ordering. The sparse method has the entries on the pattern of
+  /// its factor, which holds every entry stored in A (store whole blocks, explicit zeros included,
+  /// so that every marginal block can be read); it throws numerical_error for an entry outside.
+  /// The dense method has every entry.
   double operator()(Eigen::Index r, Eigen::Index c) const {
+    if (method_ == Method::dense) return dense_entry(r, c);
     const Eigen::Index i = permutation_(r), j = permutation_(c);
     return entry(std::max(i, j), std::min(i, j));
   }
 
   /// The symmetric block of A^-1 on rows and columns [offset, offset + size).
   Eigen::MatrixXd block(Eigen::Index offset, Eigen::Index size) const {
+    if (method_ == Method::dense) {  // A^-1 = L^-T L^-1, L^-1 lower triangular
+      const auto columns = inverse_factor_.block(offset, offset, n_ - offset, size);
+      return columns.transpose() * columns;
+    }
     Eigen::MatrixXd out(size, size);
     for (Eigen::Index c = 0; c < size; ++c)
       for (Eigen::Index r = c; r < size; ++r) out(r, c) = out(c, r) = (*this)(offset + r, offset + c);
     return out;
   }
 
+  /// Off-diagonal entries in each column of the Cholesky factor of P A P^T, P the fill-reducing
+  /// (AMD) ordering the sparse method uses: the elimination tree walked row by row (each row of
+  /// the factor is the union of the tree paths from the row's entries in A up to the diagonal).
+  static std::vector<Eigen::Index> factor_column_counts(const SparseMatrix& A) {
+    const SparseMatrix C = fill_reducing_permuted(A);
+    const Eigen::Index n = C.cols();
+    std::vector<Eigen::Index> parent(n, -1), tag(n, -1), count(n, 0);
+    for (Eigen::Index k = 0; k < n; ++k) {
+      tag[k] = k;
+      for (SparseMatrix::InnerIterator it(C, k); it; ++it) {
+        for (Eigen::Index i = it.index(); i < k && tag[i] != k; i = parent[i]) {
+          if (parent[i] == -1) parent[i] = k;
+          ++count[i];
+          tag[i] = k;
+        }
+      }
+    }
+    return count;
+  }
+
  private:
   using Factor = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>;
 
-  const SparseMatrix& L() const { return ldlt_.matrixL().nestedExpression(); }
+  static SparseMatrix fill_reducing_permuted(const SparseMatrix& A) {
+    const SparseMatrix full = A.selfadjointView<Eigen::Lower>();
+    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> inverse;
+    Eigen::AMDOrdering<int>()(full, inverse);
+    const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P = inverse.inverse();
+    SparseMatrix C;
+    C = A.selfadjointView<Eigen::Lower>().twistedBy(P);
+    return C;
+  }
+
+  /// Takahashi's recursion does one look-up per pair of entries in a column of the factor; the
+  /// dense method about 2/3 n^3 flops (factorization and triangular inverse).
+  static bool prefers_dense(const SparseMatrix& A) {
+    const Eigen::Index n = A.rows();
+    if (n > dense_limit) return false;
+    double sparse_work = 0.0;
+    for (Eigen::Index count : factor_column_counts(A)) sparse_work += static_cast<double>(count) * static_cast<double>(count);
+    const double dense_work = 2.0 / 3.0 * static_cast<double>(n) * static_cast<double>(n) * static_cast<double>(n);
+    return lookup_cost_in_flops * sparse_work > dense_work;
+  }
+
+  static void throw_not_positive_definite() { throw numerical_error("matrix to invert is not positive definite"); }
+
+  // ---- dense: A = L L^T, keep L^-1 --------------------------------------------------------------
+
+  void invert_densely(const SparseMatrix& A) {
+    n_ = A.rows();
+    Eigen::MatrixXd factor = Eigen::MatrixXd::Zero(n_, n_);  // the lower triangle is all LLT reads
+    for (Eigen::Index c = 0; c < A.outerSize(); ++c)
+      for (SparseMatrix::InnerIterator it(A, c); it; ++it)
+        if (it.row() >= it.col()) factor(it.row(), it.col()) = it.value();
+    Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Lower> llt(factor);  // in place
+    if (llt.info() != Eigen::Success) throw_not_positive_definite();
+    const auto diagonal = factor.diagonal();
+    if (!diagonal.allFinite() || (diagonal.array() <= 0.0).any()) throw_not_positive_definite();
+    // L^-1 by column blocks: column block [j, j + b) of L^-1 is zero above row j, so it solves the
+    // trailing triangle only (n^3 / 3 flops in all).
+    constexpr Eigen::Index block_size = 256;
+    inverse_factor_ = Eigen::MatrixXd::Zero(n_, n_);
+    for (Eigen::Index j = 0; j < n_; j += block_size) {
+      const Eigen::Index b = std::min(block_size, n_ - j);
+      auto columns = inverse_factor_.block(j, j, n_ - j, b);
+      columns.topRows(b).setIdentity();
+      factor.bottomRightCorner(n_ - j, n_ - j).triangularView<Eigen::Lower>().solveInPlace(columns);
+    }
+    if (!inverse_factor_.allFinite()) throw_not_positive_definite();
+  }
+
+  double dense_entry(Eigen::Index r, Eigen::Index c) const {
+    const Eigen::Index from = std::max(r, c);
+    return inverse_factor_.col(r).tail(n_ - from).dot(inverse_factor_.col(c).tail(n_ - from));
+  }
+
+  // ---- sparse: Takahashi on the pattern of the LDL^T factor --------------------------------------
+
+  void invert_sparsely(const SparseMatrix& A) {
+    ldlt_.emplace(A);
+    if (ldlt_->info() != Eigen::Success) throw_not_positive_definite();
+    const Eigen::VectorXd d = ldlt_->vectorD();
+    if ((d.array() <= 0.0).any()) throw_not_positive_definite();
+    n_ = A.rows();
+    compute(d);
+  }
+
+  const SparseMatrix& L() const { return ldlt_->matrixL().nestedExpression(); }
 
   /// Position of L(i, j), i > j, in L's value array, or -1 when (i, j) is not in the pattern.
   Eigen::Index position(Eigen::Index i, Eigen::Index j) const {
@@ -92,12 +204,15 @@ class SelectedInverse {
       for (Eigen::Index b = first; b < last; ++b) sum += values[b] * off_diagonal_[b];
       diagonal_[j] = 1.0 / d[j] - sum;
     }
-    permutation_ = ldlt_.permutationP().indices().cast<Eigen::Index>();
+    permutation_ = ldlt_->permutationP().indices().cast<Eigen::Index>();
   }
 
-  Factor ldlt_;
+  Method method_ = Method::sparse;
+  Eigen::Index n_ = 0;
+  std::optional<Factor> ldlt_;
   std::vector<double> diagonal_, off_diagonal_;
   Eigen::Matrix<Eigen::Index, Eigen::Dynamic, 1> permutation_;
+  Eigen::MatrixXd inverse_factor_;  ///< dense method: L^-1
 };
 
 }  // namespace sextant
