@@ -34,6 +34,7 @@ namespace {
 using Dataset = sim::GlobeCameraDataset;
 using Motion = EulerCamera12D;
 using Sensor = PointInCamera3D;
+using SampledPoses = std::vector<eval::SampledPose<Gaussian<Vector12d, 12>>>;
 
 /// One back-end configuration's run on the globe, scored.
 struct GlobeRun {
@@ -80,10 +81,9 @@ template <class Graph>
 void score_smoothed_marginals(const Graph& graph, const Dataset& data, const RunnerConfig& c, GlobeRun& out) {
   const auto start = std::chrono::steady_clock::now();
   const auto trajectory = graph.trajectory();
-  std::vector<eval::SampledPose<Gaussian<Vector12d, 12>>> sampled;
-  const std::size_t count = out.means.size(), period = c.globe.covariance_period;
-  for (std::size_t k = 0; k < count; ++k)
-    if ((k + 1) % period == 0 || k + 1 == count) {
+  SampledPoses sampled;
+  for (std::size_t k = 0; k < out.means.size(); ++k)
+    if (eval::is_sampled_step(k, out.means.size(), c.globe.covariance_period)) {
       sampled.push_back({k, trajectory[k + 1]});
       out.nees_steps.push_back(k);
     }
@@ -110,7 +110,6 @@ GlobeRun run_graph(const Dataset& data, const RunnerConfig& c) {
   out.label = "GraphSLAM, windows 50 x 5";
   out.pool = std::move(run.pool);
   out.total_seconds = run.total_seconds;
-  using Sampled = std::vector<eval::SampledPose<Gaussian<Vector12d, 12>>>;
   for (int update = 0; update < c.globe.graph_updates; ++update) {
     const auto start = std::chrono::steady_clock::now();
     graph.optimize();
@@ -120,7 +119,7 @@ GlobeRun run_graph(const Dataset& data, const RunnerConfig& c) {
     out.map.clear();
     for (const auto& [id, mean] : graph.landmark_means()) out.map.push_back({id, mean, Eigen::Matrix3d::Zero()});
     out.map = with_truth(std::move(out.map), data);
-    out.scores = eval::score_camera(means, Sampled{}, data.true_poses, out.map, data.true_landmarks, false);
+    out.scores = eval::score_camera(means, SampledPoses{}, data.true_poses, out.map, data.true_landmarks, false);
     out.summary = eval::summarize_camera(out.scores);
     out.means = std::move(means);
     out.graph_update_position_mae.push_back(out.summary.position_mae);

@@ -113,7 +113,7 @@ ViRun run_backend(Backend& backend, const ViData& d, PoolLimits pool, std::size_
     out.unusable += result.unusable.size();
     out.mapped += result.initialized;
     out.means.push_back(eval::pose_mean_of(backend));
-    if (covariance_period > 0 && ((k + 1) % covariance_period == 0 || k + 1 == d.frames.size()))
+    if (eval::is_sampled_step(k, d.frames.size(), covariance_period))
       out.poses.push_back({k, backend.pose()});
     ++k;
     progress.advance();

@@ -64,7 +64,8 @@ class SelectedInverse {
   Eigen::MatrixXd block(Eigen::Index offset, Eigen::Index size) const {
     if (method_ == Method::dense) {  // A^-1 = L^-T L^-1, L^-1 lower triangular
       const auto columns = inverse_factor_.block(offset, offset, n_ - offset, size);
-      return columns.transpose() * columns;
+      const Eigen::MatrixXd product = columns.transpose() * columns;
+      return 0.5 * (product + product.transpose());  // exactly symmetric, as the sparse method's
     }
     Eigen::MatrixXd out(size, size);
     for (Eigen::Index c = 0; c < size; ++c)

@@ -23,6 +23,12 @@ typename Backend::State pose_mean_of(const Backend& backend) {
     return backend.pose().mean;
 }
 
+/// Whether step k of `count` has its covariance recorded: every period-th step and the last
+/// (period 0: none).
+inline bool is_sampled_step(std::size_t k, std::size_t count, std::size_t period) {
+  return period > 0 && ((k + 1) % period == 0 || k + 1 == count);
+}
+
 template <class PoseEstimate>
 struct SampledPose {
   std::size_t step;
@@ -58,7 +64,7 @@ auto run_through_pool(Backend& backend, const Steps& steps, PoolLimits limits, s
     out.seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
     out.total_seconds += out.seconds.back();
     out.means.push_back(pose_mean_of(backend));
-    if (covariance_period > 0 && ((k + 1) % covariance_period == 0 || k + 1 == count))
+    if (is_sampled_step(k, count, covariance_period))
       out.poses.push_back({k, backend.pose()});
     on_step(k++, std::as_const(backend));
   }
