@@ -159,7 +159,7 @@ void BM_GlobeGraphMarginals(benchmark::State& state) {
   state.counters["n"] = n;
   state.counters["lookups"] = lookups;
   state.counters["dense_flops"] = 2.0 / 3.0 * n * n * n;
-  state.counters["automatic_is_dense"] = SelectedInverse(A).method() == SelectedInverse::Method::dense;
+  state.counters["automatic_is_dense"] = SelectedInverse::automatic_method(A) == SelectedInverse::Method::dense;
 }
 
 /// EKF at the end of the run: the last step's observations (all known) as one update, against an

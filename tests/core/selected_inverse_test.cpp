@@ -126,7 +126,9 @@ TEST(SelectedInverse, ColumnCountsAreThoseOfTheSparseFactor) {
 
 TEST(SelectedInverse, AutomaticTakesTheSparseMethodForAChainAndTheDenseOneWhenTheFactorFillsIn) {
   EXPECT_EQ(SelectedInverse(chain_with_loops(200, 7)).method(), SelectedInverse::Method::sparse);
-  EXPECT_EQ(SelectedInverse(poses_and_covisible_points(60, 80, 40, 8)).method(), SelectedInverse::Method::dense);
+  const auto filled_in = poses_and_covisible_points(60, 80, 40, 8);
+  EXPECT_EQ(SelectedInverse::automatic_method(filled_in), SelectedInverse::Method::dense);
+  EXPECT_EQ(SelectedInverse(filled_in).method(), SelectedInverse::Method::dense);
 }
 
 }  // namespace

@@ -38,7 +38,7 @@ class SelectedInverse {
   /// if A is not positive definite.
   explicit SelectedInverse(const SparseMatrix& A, Method method = Method::automatic) {
     if (A.rows() != A.cols()) throw invalid_input_error("selected inverse of a non-square matrix");
-    if (method == Method::automatic) method = prefers_dense(A) ? Method::dense : Method::sparse;
+    if (method == Method::automatic) method = automatic_method(A);
     method_ = method;
     if (method == Method::dense)
       invert_densely(A);
@@ -73,6 +73,18 @@ class SelectedInverse {
     return out;
   }
 
+  /// The method `automatic` takes for A: dense when Takahashi's recursion would do more work (one
+  /// look-up per pair of entries in a column of the factor) than the dense method's ~2/3 n^3 flops
+  /// (factorization and triangular inverse), and n <= dense_limit. Costs one symbolic analysis.
+  static Method automatic_method(const SparseMatrix& A) {
+    const Eigen::Index n = A.rows();
+    if (n > dense_limit) return Method::sparse;
+    double sparse_work = 0.0;
+    for (Eigen::Index count : factor_column_counts(A)) sparse_work += static_cast<double>(count) * static_cast<double>(count);
+    const double dense_work = 2.0 / 3.0 * static_cast<double>(n) * static_cast<double>(n) * static_cast<double>(n);
+    return lookup_cost_in_flops * sparse_work > dense_work ? Method::dense : Method::sparse;
+  }
+
   /// Off-diagonal entries in each column of the Cholesky factor of P A P^T, P the fill-reducing
   /// (AMD) ordering the sparse method uses: the elimination tree walked row by row (each row of
   /// the factor is the union of the tree paths from the row's entries in A up to the diagonal).
@@ -100,21 +112,12 @@ class SelectedInverse {
     const SparseMatrix full = A.selfadjointView<Eigen::Lower>();
     Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> inverse;
     Eigen::AMDOrdering<int>()(full, inverse);
-    const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P = inverse.inverse();
+    // AMD gives the inverse permutation; a permutation's inverse is its transpose (an exact
+    // re-indexing, no arithmetic).
+    const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P = inverse.transpose();
     SparseMatrix C;
     C = A.selfadjointView<Eigen::Lower>().twistedBy(P);
     return C;
-  }
-
-  /// Takahashi's recursion does one look-up per pair of entries in a column of the factor; the
-  /// dense method about 2/3 n^3 flops (factorization and triangular inverse).
-  static bool prefers_dense(const SparseMatrix& A) {
-    const Eigen::Index n = A.rows();
-    if (n > dense_limit) return false;
-    double sparse_work = 0.0;
-    for (Eigen::Index count : factor_column_counts(A)) sparse_work += static_cast<double>(count) * static_cast<double>(count);
-    const double dense_work = 2.0 / 3.0 * static_cast<double>(n) * static_cast<double>(n) * static_cast<double>(n);
-    return lookup_cost_in_flops * sparse_work > dense_work;
   }
 
   static void throw_not_positive_definite() { throw numerical_error("matrix to invert is not positive definite"); }
