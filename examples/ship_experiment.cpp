@@ -4,9 +4,19 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
-#include <sextant/sextant.hpp>
 #include <string>
 #include <vector>
+
+#include "sextant/backends/ekf_slam.hpp"
+#include "sextant/backends/fast_slam.hpp"
+#include "sextant/backends/graph_slam.hpp"
+#include "sextant/backends/seif_slam.hpp"
+#include "sextant/eval/experiment.hpp"
+#include "sextant/eval/monte_carlo.hpp"
+#include "sextant/io/csv_writer.hpp"
+#include "sextant/io/tum_writer.hpp"
+#include "sextant/models/beacon_ship_2d.hpp"
+#include "sextant/sim/ship_2d.hpp"
 
 namespace {
 

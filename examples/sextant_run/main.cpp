@@ -1,9 +1,11 @@
 // sextant-run: every back-end on the simulated ship and on MRPT rawlogs, scored against ground
 // truth, side by side. With no arguments: all back-ends on the ship Monte Carlo and on the kf-slam
-// demo rawlogs that Debian's mrpt-common installs. --dataset globe hands over to sextant-globe (the
-// thesis's 12D camera around a simulated globe), --dataset stereo-vi or FILE.npz to sextant-vislam
-// (visual-inertial SLAM on SE(3)), --dataset globe-stereo or stereo:<dir> to sextant-globe-stereo
-// (stereo images through the OpenCV front-end): programs of their own so that the main job does not compile them.
+// demo rawlogs that Debian's mrpt-common installs. The other data-set families run in programs of
+// their own, so that the main job does not compile them, and sextant-run hands them over
+// (kHandOvers): --dataset globe to sextant-globe (the thesis's 12D camera around a simulated globe),
+// stereo-vi or FILE.npz to sextant-vislam (visual-inertial SLAM on SE(3)), globe-stereo or
+// stereo:<dir> to sextant-globe-stereo (stereo images through the OpenCV front-end),
+// mrclam:<dir>:<robot> to sextant-run-mrclam, FILE.txt (iSAM text) to sextant-run-isam.
 // See docs/runner.md.
 #include <algorithm>
 #include <cerrno>
@@ -26,12 +28,6 @@ using namespace sextant::runner;
 const char* const kMrptDatasets = "/usr/share/mrpt/datasets";
 const std::vector<std::string> kMrptDemos = {"kf-slam_demo.rawlog", "kf-slam_6D_demo.rawlog",
                                              "kf-slam_6D_demo_noncentered.rawlog"};
-
-/// A data set in the iSAM/GTSAM text format: named .txt or .graph (rawlogs are binary).
-bool is_isam_text(const std::string& path) {
-  const auto extension = std::filesystem::path(path).extension();
-  return extension == ".txt" || extension == ".graph";
-}
 
 /// "ship", "mrpt-demos" (the installed demo rawlogs) or a rawlog path, expanded.
 std::vector<std::string> expand_datasets(const std::vector<std::string>& requested) {
@@ -72,15 +68,21 @@ std::vector<TableRow> run_rawlog(const CliOptions& options, const std::string& p
       dataset);
 }
 
-/// --dataset globe runs alone, in sextant-globe (next to this program), with the same arguments.
-bool wants_globe(const CliOptions& options) {
-  const auto& d = options.datasets;
-  if (std::find(d.begin(), d.end(), "globe") == d.end()) return false;
-  if (d.size() != 1)
-    throw invalid_input_error("--dataset globe runs alone (it is the program sextant-globe); give the other data sets in "
-                              "a second call");
-  return true;
-}
+bool is_globe_dataset(const std::string& dataset) { return dataset == "globe"; }
+
+/// A family of data sets that runs in a program of its own next to sextant-run.
+struct HandOver {
+  bool (*is_its)(const std::string&);
+  const char* what;  ///< the family, for messages
+  const char* program;
+};
+const HandOver kHandOvers[] = {
+    {is_stereo_image_dataset, "globe-stereo and stereo:<dir>", "sextant-globe-stereo"},
+    {is_globe_dataset, "globe", "sextant-globe"},
+    {is_vislam_dataset, "stereo-vi and .npz files", "sextant-vislam"},
+    {is_mrclam_dataset, "mrclam:<dir>:<robot>", "sextant-run-mrclam"},
+    {is_isam_dataset, ".txt and .graph files (iSAM text)", "sextant-run-isam"},
+};
 
 /// Whether the data sets are `program`'s (is_its): they run there alone, all of them in one call,
 /// so a mixture with the others is an error. `what` names them for the message.
@@ -89,7 +91,7 @@ bool wants(const CliOptions& options, bool (*is_its)(const std::string&), const 
   const auto count = std::count_if(d.begin(), d.end(), is_its);
   if (count == 0) return false;
   if (static_cast<std::size_t>(count) != d.size())
-    throw invalid_input_error(std::string("--dataset ") + what + " run alone (in the program " + program +
+    throw invalid_input_error(std::string("--dataset ") + what + ": runs alone (in the program " + program +
                               "); give the other data sets in a second call");
   return true;
 }
@@ -110,19 +112,15 @@ int main(int argc, char** argv) {
   return runner_main(argc, argv, "sextant-run",
                      "sextant-run: SLAM back-ends on the simulated ship and on MRPT rawlogs, side by side",
                      [argv](CliOptions& options) {
-                       if (wants(options, is_stereo_image_dataset, "globe-stereo and stereo:<dir>", "sextant-globe-stereo"))
-                         return hand_over_to("sextant-globe-stereo", argv);
-                       if (wants_globe(options)) return hand_over_to("sextant-globe", argv);
-                       if (wants(options, is_vislam_dataset, "stereo-vi and .npz files", "sextant-vislam"))
-                         return hand_over_to("sextant-vislam", argv);
+                       for (const auto& family : kHandOvers)
+                         if (wants(options, family.is_its, family.what, family.program))
+                           return hand_over_to(family.program, argv);
                        const RunnerConfig config = load_runner_config(options);
                        const auto kinds = parse_backends(options.backends);
                        std::vector<TableRow> rows;
                        for (const auto& dataset : expand_datasets(options.datasets)) {
-                         auto part = dataset == "ship"                ? run_ship(options.output, kinds, config)
-                                     : dataset.rfind("mrclam:", 0) == 0 ? run_mrclam(options.output, dataset.substr(7), kinds, config)
-                                     : is_isam_text(dataset)            ? run_isam(options.output, dataset, kinds, config)
-                                                                        : run_rawlog(options, dataset, kinds, config);
+                         auto part = dataset == "ship" ? run_ship(options.output, kinds, config)
+                                                       : run_rawlog(options, dataset, kinds, config);
                          rows.insert(rows.end(), part.begin(), part.end());
                        }
                        finish_run(options, rows);

@@ -59,6 +59,16 @@ inline bool is_stereo_image_dataset(const std::string& dataset) {
   return dataset == "globe-stereo" || dataset.rfind("stereo:", 0) == 0;
 }
 
+/// A data set of sextant-run-mrclam: "mrclam:<directory>:<robot 1-5 | all>".
+inline bool is_mrclam_dataset(const std::string& dataset) { return dataset.rfind("mrclam:", 0) == 0; }
+
+/// A data set of sextant-run-isam: a planar file in the iSAM/GTSAM text format, named .txt or .graph
+/// (rawlogs are binary).
+inline bool is_isam_dataset(const std::string& dataset) {
+  const auto extension = std::filesystem::path(dataset).extension();
+  return extension == ".txt" || extension == ".graph";
+}
+
 inline std::vector<BackendKind> parse_backends(const std::vector<std::string>& names) {
   std::vector<BackendKind> kinds;
   for (const auto& name : names) {
@@ -124,6 +134,35 @@ int runner_main(int argc, char** argv, const char* program, const std::string& d
     std::fprintf(stderr, "%s: %s\n", program, one_line(e.what()).c_str());
     return 1;
   }
+}
+
+}  // namespace sextant::runner
+
+namespace sextant::runner {
+
+/// main() of a program that runs one family of data sets alone (sextant-run hands them over to it,
+/// so that the main job does not compile them): every --dataset must be the family's (`is_its`;
+/// `what` names the family in the message), none given means `defaults`; each runs through
+/// `run_one(output, dataset, kinds, config)`, then the legend.
+template <class RunOne>
+int family_main(int argc, char** argv, const char* program, const std::string& description,
+                bool (*is_its)(const std::string&), const char* what, RunOne run_one,
+                const std::vector<std::string>& defaults = {}) {
+  return runner_main(argc, argv, program, description, [&](CliOptions& options) {
+    if (options.datasets.empty()) options.datasets = defaults;
+    for (const auto& dataset : options.datasets)
+      if (!is_its(dataset))
+        throw invalid_input_error("--dataset " + dataset + ": " + program + " runs " + what + " (sextant-run runs the rest)");
+    const RunnerConfig config = load_runner_config(options);
+    const auto kinds = parse_backends(options.backends);
+    std::vector<TableRow> rows;
+    for (const auto& dataset : options.datasets) {
+      auto part = run_one(options.output, dataset, kinds, config);
+      rows.insert(rows.end(), part.begin(), part.end());
+    }
+    finish_run(options, rows);
+    return 0;
+  });
 }
 
 }  // namespace sextant::runner

@@ -146,11 +146,25 @@ TEST_F(RunnerCli, GlobeRunsEveryBackEndThroughThePoolAndWritesBookkeepingAndScen
 TEST_F(RunnerCli, GlobeRunsAloneInItsOwnProgram) {
   // sextant-run hands --dataset globe over to sextant-globe; mixing it with other data sets, or giving
   // sextant-globe another data set, is refused with one line.
-  expect_one_line_error("-d globe -d ship", {"--dataset globe runs alone", "sextant-globe"});
+  expect_one_line_error("-d globe -d ship", {"--dataset globe: runs alone", "sextant-globe"});
   const std::string globe = (fs::path(SEXTANT_RUN_EXE).parent_path() / "sextant-globe").string();
   const auto r = run_program(globe + " -d ship", dir);
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("sextant-globe runs only the globe"), std::string::npos) << r.err;
+}
+
+TEST_F(RunnerCli, MrclamAndIsamRunInTheirOwnPrograms) {
+  // The main job does not compile them: sextant-run hands mrclam:... to sextant-run-mrclam and iSAM
+  // text files to sextant-run-isam, and refuses a mixture with one line naming the program; each
+  // program refuses the other data sets.
+  expect_one_line_error("-d ship -d mrclam:/nowhere:1", {"--dataset mrclam", "runs alone", "sextant-run-mrclam"});
+  expect_one_line_error("-d ship -d loop.txt", {"runs alone", "sextant-run-isam"});
+  const auto bin = fs::path(SEXTANT_RUN_EXE).parent_path();
+  for (const char* program : {"sextant-run-mrclam", "sextant-run-isam"}) {
+    const auto r = run_program((bin / program).string() + " -d ship", dir);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.err.find(std::string(program) + " runs"), std::string::npos) << r.err;
+  }
 }
 
 TEST_F(RunnerCli, SpatialRunDrawsLandmarkEllipsoids) {

@@ -104,7 +104,7 @@ TEST_F(VislamRunner, SextantRunHandsStereoViAndNpzOverAndRefusesMixtures) {
   const auto mixed = run_program(std::string(SEXTANT_RUN_EXE) + " -d stereo-vi -d ship", dir);
   EXPECT_NE(mixed.exit_code, 0);
   EXPECT_EQ(mixed.err.find('\n'), mixed.err.size() - 1) << "not one line: " << mixed.err;
-  EXPECT_NE(mixed.err.find("run alone"), std::string::npos) << mixed.err;
+  EXPECT_NE(mixed.err.find("runs alone"), std::string::npos) << mixed.err;
   EXPECT_NE(mixed.err.find("sextant-vislam"), std::string::npos) << mixed.err;
 
   const auto other = run_program(std::string(SEXTANT_VISLAM_EXE) + " -d ship", dir);

@@ -4,9 +4,12 @@
 
 #include <Eigen/Dense>
 #include <map>
+#include <random>
 #include <vector>
 
-#include "sextant/sextant.hpp"
+#include "sextant/core/gaussian.hpp"
+#include "sextant/core/observation.hpp"
+#include "sextant/models/beacon_ship_2d.hpp"
 #include "sextant/sim/ordered_draws.hpp"
 
 namespace sextant::test {

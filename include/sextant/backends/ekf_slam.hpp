@@ -155,3 +155,8 @@ class EkfSlam {
 }  // namespace sextant
 
 #include "sextant/backends/detail/ekf_slam_impl.hpp"
+
+// Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
+// are declared extern when the program links sextant::compiled.
+#define SEXTANT_DECLARED_EKF_SLAM
+#include "sextant/compiled/extern_instances.hpp"

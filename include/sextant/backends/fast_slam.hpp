@@ -191,3 +191,8 @@ class FastSlam {
 }  // namespace sextant
 
 #include "sextant/backends/detail/fast_slam_impl.hpp"
+
+// Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
+// are declared extern when the program links sextant::compiled.
+#define SEXTANT_DECLARED_FAST_SLAM
+#include "sextant/compiled/extern_instances.hpp"

@@ -195,3 +195,8 @@ class GraphSlam {
 }  // namespace sextant
 
 #include "sextant/backends/detail/graph_slam_impl.hpp"
+
+// Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
+// are declared extern when the program links sextant::compiled.
+#define SEXTANT_DECLARED_GRAPH_SLAM
+#include "sextant/compiled/extern_instances.hpp"

@@ -208,3 +208,8 @@ class SeifSlam {
 }  // namespace sextant
 
 #include "sextant/backends/detail/seif_slam_impl.hpp"
+
+// Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
+// are declared extern when the program links sextant::compiled.
+#define SEXTANT_DECLARED_SEIF_SLAM
+#include "sextant/compiled/extern_instances.hpp"

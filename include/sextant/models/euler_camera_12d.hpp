@@ -259,3 +259,8 @@ struct PointInCamera3D {
 };
 
 }  // namespace sextant
+
+// Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
+// are declared extern when the program links sextant::compiled.
+#define SEXTANT_DECLARED_EULER_CAMERA_12D
+#include "sextant/compiled/extern_instances.hpp"

@@ -48,3 +48,8 @@ struct PointInRobotFrame2D {
 };
 
 }  // namespace sextant
+
+// Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
+// are declared extern when the program links sextant::compiled.
+#define SEXTANT_DECLARED_POINT_IN_ROBOT_FRAME_2D
+#include "sextant/compiled/extern_instances.hpp"

@@ -77,3 +77,8 @@ struct RangeBearing3D {
 };
 
 }  // namespace sextant
+
+// Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
+// are declared extern when the program links sextant::compiled.
+#define SEXTANT_DECLARED_RANGE_BEARING_3D
+#include "sextant/compiled/extern_instances.hpp"

@@ -120,3 +120,8 @@ inline Gaussian<Eigen::Vector3d, 3> in_world_frame(const Gaussian<Eigen::Vector3
 }
 
 }  // namespace sextant
+
+// Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
+// are declared extern when the program links sextant::compiled.
+#define SEXTANT_DECLARED_SE2_WORLD_FRAME
+#include "sextant/compiled/extern_instances.hpp"

@@ -62,3 +62,8 @@ struct Se3Odometry {
 };
 
 }  // namespace sextant
+
+// Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
+// are declared extern when the program links sextant::compiled.
+#define SEXTANT_DECLARED_SE3_ODOMETRY
+#include "sextant/compiled/extern_instances.hpp"

@@ -218,3 +218,8 @@ using StereoPixelsSe3 = StereoPixelsSe3Of<Se3Perturbation::world>;
 using StereoPixelsSe3Body = StereoPixelsSe3Of<Se3Perturbation::body>;
 
 }  // namespace sextant
+
+// Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
+// are declared extern when the program links sextant::compiled.
+#define SEXTANT_DECLARED_STEREO_IMU_SE3
+#include "sextant/compiled/extern_instances.hpp"

@@ -75,3 +75,8 @@ struct Unicycle {
 };
 
 }  // namespace sextant
+
+// Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
+// are declared extern when the program links sextant::compiled.
+#define SEXTANT_DECLARED_UNICYCLE
+#include "sextant/compiled/extern_instances.hpp"

@@ -1,0 +1,6 @@
+// sextant::compiled: every back-end for planar iSAM text data sets (SE(2) odometry, points in the robot frame) (docs/build_times.md).
+#include "define_instances.hpp"
+#include "sextant/models/point_in_robot_frame_2d.hpp"
+#include "sextant/models/se2_odometry.hpp"
+
+SEXTANT_DEFINE_INSTANCES(sextant::Se2Odometry, sextant::PointInRobotFrame2D)
