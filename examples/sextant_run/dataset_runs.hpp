@@ -1,12 +1,14 @@
 #pragma once
 // The runner's data-set runs, each compiled in its own translation unit (the rawlog ones: rawlog_runs.hpp).
+// Declarations only, so that the programs' main() units compile without the config and the table.
 #include <string>
 #include <vector>
 
-#include "runner_config.hpp"
-#include "table.hpp"
+#include "table_row.hpp"
 
 namespace sextant::runner {
+
+struct RunnerConfig;  // runner_config.hpp
 
 /// Where and what to write besides the table.
 struct RunOptions {
@@ -16,6 +18,9 @@ struct RunOptions {
 
 /// The simulated ship, config.ship_runs Monte Carlo runs (run_ship.cpp).
 std::vector<TableRow> run_ship(const RunOptions& options, const std::vector<BackendKind>& kinds, const RunnerConfig& config);
+/// A rawlog with its ground truth beside it, planar or spatial as the log is (run_planar_rawlog.cpp).
+std::vector<TableRow> run_rawlog(const RunOptions& options, const std::string& path, const std::vector<BackendKind>& kinds,
+                                 const RunnerConfig& config);
 /// The simulated globe: the 12D camera, every back-end through the landmark pool (run_globe.cpp).
 std::vector<TableRow> run_globe(const RunOptions& options, const std::vector<BackendKind>& kinds, const RunnerConfig& config);
 

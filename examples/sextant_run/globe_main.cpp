@@ -3,18 +3,14 @@
 // sextant-run's options (sextant-run --dataset globe hands over to it); see docs/runner.md.
 #include "runner_cli.hpp"
 
+using namespace sextant::runner;
+
 int main(int argc, char** argv) {
-  using namespace sextant::runner;
-  return runner_main(argc, argv, "sextant-globe",
-                     "sextant-globe: the thesis's 12D camera around a simulated globe, every back-end through the "
-                     "landmark pool",
-                     [](CliOptions& options) {
-                       for (const auto& dataset : options.datasets)
-                         if (dataset != "globe")
-                           throw sextant::invalid_input_error("--dataset " + dataset +
-                                                              ": sextant-globe runs only the globe (sextant-run runs the rest)");
-                       const RunnerConfig config = load_runner_config(options);
-                       finish_run(options, run_globe(options.output, parse_backends(options.backends), config));
-                       return 0;
-                     });
+  return family_main(
+      argc, argv, "sextant-globe",
+      "sextant-globe: the thesis's 12D camera around a simulated globe, every back-end through the landmark pool",
+      [](const std::string& dataset) { return dataset == "globe"; }, "only the globe",
+      [](const CliOptions& options, const std::string&, const std::vector<BackendKind>& kinds,
+         const RunnerConfig& config) { return run_globe(options.output, kinds, config); },
+      {"globe"});
 }

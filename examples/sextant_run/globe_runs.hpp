@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "dataset_runs.hpp"
+#include "runner_config.hpp"
 
 namespace sextant::runner {
 

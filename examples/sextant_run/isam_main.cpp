@@ -4,9 +4,12 @@
 // not compile it); see docs/runner.md.
 #include "runner_cli.hpp"
 
+using namespace sextant::runner;
+
 int main(int argc, char** argv) {
-  using namespace sextant::runner;
-  return family_main(argc, argv, "sextant-run-isam",
-                     "sextant-run-isam: SLAM back-ends on a planar iSAM/GTSAM text data set",
-                     is_isam_dataset, ".txt and .graph files (iSAM/GTSAM planar text)", run_isam);
+  return family_main(
+      argc, argv, "sextant-run-isam", "sextant-run-isam: SLAM back-ends on a planar iSAM/GTSAM text data set",
+      is_isam_dataset, ".txt and .graph files (iSAM/GTSAM planar text)",
+      [](const CliOptions& options, const std::string& dataset, const std::vector<BackendKind>& kinds,
+         const RunnerConfig& config) { return run_isam(options.output, dataset, kinds, config); });
 }

@@ -14,11 +14,10 @@
 #include <filesystem>
 #include <string>
 #include <unistd.h>
-#include <variant>
 #include <vector>
 
-#include "rawlog_runs.hpp"
 #include "runner_cli.hpp"
+#include "sextant/core/error.hpp"
 
 namespace {
 
@@ -29,10 +28,10 @@ const char* const kMrptDatasets = "/usr/share/mrpt/datasets";
 const std::vector<std::string> kMrptDemos = {"kf-slam_demo.rawlog", "kf-slam_6D_demo.rawlog",
                                              "kf-slam_6D_demo_noncentered.rawlog"};
 
-/// "ship", "mrpt-demos" (the installed demo rawlogs) or a rawlog path, expanded.
+/// The installed demo rawlogs in place of "mrpt-demos", each that exists.
 std::vector<std::string> expand_datasets(const std::vector<std::string>& requested) {
   std::vector<std::string> out;
-  for (const auto& d : requested.empty() ? std::vector<std::string>{"ship", "mrpt-demos"} : requested) {
+  for (const auto& d : requested) {
     if (d != "mrpt-demos") {
       out.push_back(d);
       continue;
@@ -46,26 +45,14 @@ std::vector<std::string> expand_datasets(const std::vector<std::string>& request
   return out;
 }
 
-/// The ground-truth files beside a rawlog, which sextant-run needs to score the runs.
-mrpt_io::GroundTruthFiles require_ground_truth(const std::string& path) {
-  const auto truth = mrpt_io::find_ground_truth(path);
-  if (!truth)
-    throw parse_error(path + ": no ground truth beside it (<name>_ground_truth.txt and "
-                             "<name>_ground_truth_robot_path.txt); sextant-run scores against ground truth");
-  return *truth;
-}
+/// sextant-run's own data sets: the ship, the demo rawlogs, a rawlog; the other families' go to their
+/// programs (kHandOvers) before this is asked.
+bool is_main_dataset(const std::string&) { return true; }
 
-/// A rawlog with the MRPT ground-truth files beside it, as planar or spatial.
-std::vector<TableRow> run_rawlog(const CliOptions& options, const std::string& path, const std::vector<BackendKind>& kinds,
-                                 const RunnerConfig& config) {
-  const std::string name = std::filesystem::path(path).filename().string();
-  auto dataset = mrpt_io::read_rawlog(path, config.rawlog);
-  return std::visit(
-      [&](auto& data) {
-        mrpt_io::attach_ground_truth(data, require_ground_truth(path));
-        return run_rawlog_dataset(options.output, name, data, kinds, config);
-      },
-      dataset);
+std::vector<TableRow> run_main_dataset(const CliOptions& options, const std::string& dataset,
+                                       const std::vector<BackendKind>& kinds, const RunnerConfig& config) {
+  if (dataset == "ship") return run_ship(options.output, kinds, config);
+  return run_rawlog(options.output, dataset, kinds, config);
 }
 
 bool is_globe_dataset(const std::string& dataset) { return dataset == "globe"; }
@@ -115,15 +102,7 @@ int main(int argc, char** argv) {
                        for (const auto& family : kHandOvers)
                          if (wants(options, family.is_its, family.what, family.program))
                            return hand_over_to(family.program, argv);
-                       const RunnerConfig config = load_runner_config(options);
-                       const auto kinds = parse_backends(options.backends);
-                       std::vector<TableRow> rows;
-                       for (const auto& dataset : expand_datasets(options.datasets)) {
-                         auto part = dataset == "ship" ? run_ship(options.output, kinds, config)
-                                                       : run_rawlog(options, dataset, kinds, config);
-                         rows.insert(rows.end(), part.begin(), part.end());
-                       }
-                       finish_run(options, rows);
-                       return 0;
+                       return run_datasets(options, "sextant-run", is_main_dataset, "the ship and rawlogs",
+                                           run_main_dataset, {"ship", "mrpt-demos"}, expand_datasets);
                      });
 }

@@ -3,11 +3,12 @@
 // main job does not compile it); see docs/runner.md.
 #include "runner_cli.hpp"
 
+using namespace sextant::runner;
+
 int main(int argc, char** argv) {
-  using namespace sextant::runner;
-  return family_main(argc, argv, "sextant-run-mrclam",
-                     "sextant-run-mrclam: SLAM back-ends on the UTIAS MRCLAM robots against Vicon ground truth",
-                     is_mrclam_dataset, "mrclam:<dir>:<robot 1-5|all>",
-                     [](const RunOptions& output, const std::string& dataset, const std::vector<BackendKind>& kinds,
-                        const RunnerConfig& config) { return run_mrclam(output, dataset.substr(7), kinds, config); });
+  return family_main(
+      argc, argv, "sextant-run-mrclam", "sextant-run-mrclam: SLAM back-ends on the UTIAS MRCLAM robots against Vicon",
+      is_mrclam_dataset, "mrclam:<dir>:<robot 1-5|all>",
+      [](const CliOptions& options, const std::string& dataset, const std::vector<BackendKind>& kinds,
+         const RunnerConfig& config) { return run_mrclam(options.output, dataset.substr(7), kinds, config); });
 }

@@ -17,6 +17,8 @@
 #include "globe_runs.hpp"
 #include "plot_script.hpp"
 #include "progress_bar.hpp"
+#include "runner_config.hpp"
+#include "table.hpp"
 
 namespace sextant::runner {
 

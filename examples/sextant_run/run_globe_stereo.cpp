@@ -21,6 +21,8 @@
 #include "globe_runs.hpp"
 #include "globe_stereo_runs.hpp"
 #include "progress_bar.hpp"
+#include "runner_config.hpp"
+#include "table.hpp"
 
 namespace sextant::runner {
 namespace {

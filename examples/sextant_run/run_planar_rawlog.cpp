@@ -1,8 +1,36 @@
-// sextant-run's planar rawlog part: every chosen back-end on one planar MRPT rawlog.
+// sextant-run's rawlog part: reading a rawlog with its ground truth, and every chosen back-end on a
+// planar one (the spatial ones: run_spatial_rawlog.cpp).
+#include <filesystem>
+#include <variant>
+
 #include "dataset_runner.hpp"
 #include "rawlog_runs.hpp"
 
 namespace sextant::runner {
+namespace {
+
+/// The ground-truth files beside a rawlog, which sextant-run needs to score the runs.
+mrpt_io::GroundTruthFiles require_ground_truth(const std::string& path) {
+  const auto truth = mrpt_io::find_ground_truth(path);
+  if (!truth)
+    throw parse_error(path + ": no ground truth beside it (<name>_ground_truth.txt and "
+                             "<name>_ground_truth_robot_path.txt); sextant-run scores against ground truth");
+  return *truth;
+}
+
+}  // namespace
+
+std::vector<TableRow> run_rawlog(const RunOptions& options, const std::string& path, const std::vector<BackendKind>& kinds,
+                                 const RunnerConfig& config) {
+  const std::string name = std::filesystem::path(path).filename().string();
+  auto dataset = mrpt_io::read_rawlog(path, config.rawlog);
+  return std::visit(
+      [&](auto& data) {
+        mrpt_io::attach_ground_truth(data, require_ground_truth(path));
+        return run_rawlog_dataset(options, name, data, kinds, config);
+      },
+      dataset);
+}
 
 std::vector<TableRow> run_rawlog_dataset(const RunOptions& options, const std::string& name,
                                          const mrpt_io::RawlogDataset2D& data, const std::vector<BackendKind>& kinds,

@@ -21,6 +21,8 @@
 
 #include "plot_script.hpp"
 #include "progress_bar.hpp"
+#include "runner_config.hpp"
+#include "table.hpp"
 #include "vislam_runs.hpp"
 
 namespace sextant::runner {

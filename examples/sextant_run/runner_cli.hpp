@@ -1,16 +1,13 @@
 #pragma once
-// The command line that sextant-run and sextant-globe share: options, back-end names, the legend and
-// summary.json after the table, one-line errors.
-#include <CLI/CLI.hpp>
-#include <algorithm>
-#include <cstdio>
+// The command line that sextant-run and the programs it hands data sets over to share: options,
+// back-end names, the legend and summary.json after the table, one-line errors. Declarations only:
+// runner_cli.cpp is compiled once for all of them (docs/build_times.md).
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "dataset_runs.hpp"
-#include "runner_config.hpp"
-#include "table.hpp"
 
 namespace sextant::runner {
 
@@ -24,30 +21,6 @@ struct CliOptions {
   std::string save_images;  ///< globe-stereo: write the rendered sequence here
   RunOptions output;
 };
-
-/// Declares the options both programs take.
-inline void add_runner_options(CLI::App& app, CliOptions& options) {
-  app.add_option("--backend,-b", options.backends, "ekf|seif|graph|fastslam1|fastslam2|all (repeatable)")
-      ->delimiter(',')
-      ->capture_default_str();
-  app.add_option("--dataset,-d", options.datasets,
-                 "ship | globe | globe-stereo | stereo:<dir> | stereo-vi | <file.npz> | mrpt-demos | <file.rawlog> | <file.txt> (iSAM/GTSAM planar text) | mrclam:<dir>:<robot 1-5|all> "
-                 "(repeatable; default: ship and the "
-                 "MRPT kf-slam demos)");
-  app.add_option("--config,-c", options.config, "ini file (MRPT CConfigFile) with [ship] [globe] [vislam] [rawlog] [ekf] [seif] [graph] "
-                                                "[fastslam] [scene] keys; see --print-config");
-  app.add_option("--out,-o", options.output.out, "directory for per-step CSV, TUM, .3Dscene files and summary.json");
-  app.add_option("--associate", options.associate,
-                 "known|nn|jcbb: use the data set's landmark ids, or withhold them and associate by nearest neighbour "
-                 "or JCBB (EKF and SEIF; FastSLAM associates per particle; overrides [association] method)");
-  app.add_option("--runs", options.runs, "Monte Carlo runs on the ship (overrides [ship] runs)")->check(CLI::Range(1, 100000));
-  app.add_flag("--plots", options.output.plots, "also write PNG plots of trajectory, map, error and NEES (needs --out or "
-                                                "writes to ./sextant-run-output)");
-  app.add_option("--save-images", options.save_images,
-                 "globe-stereo: also write the rendered stereo sequence to this directory (left/, right/, calib.yaml), "
-                 "which --dataset stereo:<dir> reads back");
-  app.add_flag("--print-config", options.print_config, "print every config key with its default and meaning, then exit");
-}
 
 /// A data set of sextant-vislam: the simulated stereo car or a .npz file.
 inline bool is_vislam_dataset(const std::string& dataset) {
@@ -69,100 +42,34 @@ inline bool is_isam_dataset(const std::string& dataset) {
   return extension == ".txt" || extension == ".graph";
 }
 
-inline std::vector<BackendKind> parse_backends(const std::vector<std::string>& names) {
-  std::vector<BackendKind> kinds;
-  for (const auto& name : names) {
-    if (name == "all") return all_backends();
-    const auto it = std::find_if(all_backends().begin(), all_backends().end(),
-                                 [&](BackendKind k) { return backend_key(k) == name; });
-    if (it == all_backends().end())
-      throw invalid_input_error("--backend: unknown back-end '" + name + "' (ekf|seif|graph|fastslam1|fastslam2|all)");
-    if (std::find(kinds.begin(), kinds.end(), *it) == kinds.end()) kinds.push_back(*it);
-  }
-  return kinds;
-}
+std::vector<BackendKind> parse_backends(const std::vector<std::string>& names);
 
 /// The config file with the command line's overrides applied.
-inline RunnerConfig load_runner_config(CliOptions& options) {
-  RunnerConfig config = load_config(options.config);
-  if (options.runs > 0) config.ship_runs = options.runs;
-  if (!options.associate.empty()) {
-    const auto key = std::find_if(config_keys().begin(), config_keys().end(),
-                                  [](const ConfigKey& k) { return k.section == "association" && k.key == "method"; });
-    try {
-      key->apply(config, options.associate);
-    } catch (const invalid_input_error& e) {
-      throw invalid_input_error(std::string("--associate: ") + e.what());
-    }
-  }
-  if (options.output.plots && options.output.out.empty()) options.output.out = "sextant-run-output";
-  return config;
-}
+RunnerConfig load_runner_config(CliOptions& options);
 
 /// What follows the table: the legend of its columns and, with --out, summary.json.
-inline void finish_run(const CliOptions& options, const std::vector<TableRow>& rows) {
-  std::printf("\naligned: the same error after the best rigid alignment of the trajectory (map) to the truth; "
-              "NEES in: share of steps (pose) or landmarks (map) whose NEES is inside the 95%% chi-square bound; "
-              "pose ANEES: mean NEES over steps and runs (pose dof: ship 2, planar 3, 6D 6).\n");
-  if (options.output.out.empty()) return;
-  std::filesystem::create_directories(options.output.out);
-  const auto json = (std::filesystem::path(options.output.out) / "summary.json").string();
-  write_summary_json(json, rows);
-  std::printf("wrote %s\n", json.c_str());
-}
+void finish_run(const CliOptions& options, const std::vector<TableRow>& rows);
 
-inline std::string one_line(const std::string& text) {
-  std::string line = text.substr(0, text.find('\n'));
-  return line.empty() ? "unknown error" : line;
-}
-
-/// Both programs' main: parse the options, answer --print-config, then `run(options)`; an error is
+/// Every program's main: parse the options, answer --print-config, then `run(options)`; an error is
 /// one line on stderr, naming the program, and exit code 1.
-template <class Run>
-int runner_main(int argc, char** argv, const char* program, const std::string& description, Run run) {
-  CLI::App app{description};
-  CliOptions options;
-  add_runner_options(app, options);
-  CLI11_PARSE(app, argc, argv);
-  if (options.print_config) {
-    std::fputs(documented_defaults().c_str(), stdout);
-    return 0;
-  }
-  try {
-    return run(options);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: %s\n", program, one_line(e.what()).c_str());
-    return 1;
-  }
-}
+int runner_main(int argc, char** argv, const char* program, const std::string& description,
+                const std::function<int(CliOptions&)>& run);
 
-}  // namespace sextant::runner
+/// One data set of a program's family: its rows of the table.
+using DatasetRun = std::vector<TableRow> (*)(const CliOptions& options, const std::string& dataset,
+                                             const std::vector<BackendKind>& kinds, const RunnerConfig& config);
 
-namespace sextant::runner {
+/// Runs a family's data sets: every --dataset must be the family's (`is_its`; `what` names the
+/// family in the message), none given means `defaults`, `expand` (if given) turns the list into the
+/// data sets to run; each runs through `run_one`, then the legend. Returns main's exit code.
+int run_datasets(CliOptions& options, const char* program, bool (*is_its)(const std::string&), const char* what,
+                 DatasetRun run_one, const std::vector<std::string>& defaults = {},
+                 std::vector<std::string> (*expand)(const std::vector<std::string>&) = nullptr);
 
 /// main() of a program that runs one family of data sets alone (sextant-run hands them over to it,
-/// so that the main job does not compile them): every --dataset must be the family's (`is_its`;
-/// `what` names the family in the message), none given means `defaults`; each runs through
-/// `run_one(output, dataset, kinds, config)`, then the legend.
-template <class RunOne>
+/// so that the main job does not compile them): runner_main around run_datasets.
 int family_main(int argc, char** argv, const char* program, const std::string& description,
-                bool (*is_its)(const std::string&), const char* what, RunOne run_one,
-                const std::vector<std::string>& defaults = {}) {
-  return runner_main(argc, argv, program, description, [&](CliOptions& options) {
-    if (options.datasets.empty()) options.datasets = defaults;
-    for (const auto& dataset : options.datasets)
-      if (!is_its(dataset))
-        throw invalid_input_error("--dataset " + dataset + ": " + program + " runs " + what + " (sextant-run runs the rest)");
-    const RunnerConfig config = load_runner_config(options);
-    const auto kinds = parse_backends(options.backends);
-    std::vector<TableRow> rows;
-    for (const auto& dataset : options.datasets) {
-      auto part = run_one(options.output, dataset, kinds, config);
-      rows.insert(rows.end(), part.begin(), part.end());
-    }
-    finish_run(options, rows);
-    return 0;
-  });
-}
+                bool (*is_its)(const std::string&), const char* what, DatasetRun run_one,
+                const std::vector<std::string>& defaults = {});
 
 }  // namespace sextant::runner

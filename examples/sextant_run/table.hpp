@@ -1,6 +1,6 @@
 #pragma once
-// The comparison table's rows: which back-end, with what settings, and its scores; printing them and
-// writing them as JSON. Light: no back-end is instantiated here.
+// The comparison table: the names of back-ends with their settings, printing the rows and writing
+// them as JSON. Light: no back-end is instantiated here.
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -13,28 +13,9 @@
 #include <vector>
 
 #include "runner_config.hpp"
+#include "table_row.hpp"
 
 namespace sextant::runner {
-
-enum class BackendKind { ekf, seif, graph, fastslam1, fastslam2 };
-
-inline const std::vector<BackendKind>& all_backends() {
-  static const std::vector<BackendKind> all = {BackendKind::ekf, BackendKind::seif, BackendKind::graph,
-                                               BackendKind::fastslam1, BackendKind::fastslam2};
-  return all;
-}
-
-/// The command-line name of a back-end (also the prefix of its output files).
-inline std::string backend_key(BackendKind kind) {
-  switch (kind) {
-    case BackendKind::ekf: return "ekf";
-    case BackendKind::seif: return "seif";
-    case BackendKind::graph: return "graph";
-    case BackendKind::fastslam1: return "fastslam1";
-    case BackendKind::fastslam2: return "fastslam2";
-  }
-  return "?";
-}
 
 /// The table's name of a back-end with its main setting.
 inline std::string backend_label(BackendKind kind, const RunnerConfig& c) {
@@ -48,25 +29,6 @@ inline std::string backend_label(BackendKind kind, const RunnerConfig& c) {
   }
   return "?";
 }
-
-/// How a data set is scored: which pose entries are position, the degrees of freedom for NEES.
-struct Scoring {
-  int position_dim, pose_dof, landmark_dof;
-};
-
-/// How a run with withheld ids associated its measurements (eval::AssociationScore).
-struct AssociationRow {
-  double precision, recall;
-  std::size_t wrong, duplicates, discarded;
-};
-
-/// A line of the comparison table.
-struct TableRow {
-  std::string dataset, backend, label;
-  eval::Summary summary;
-  int runs = 1;
-  std::optional<AssociationRow> association;
-};
 
 /// The table's header line; the README's results table must show the same (tests/mrpt/runner_cli_test).
 inline void print_header() {

@@ -5,9 +5,14 @@
 #include "runner_cli.hpp"
 #include "vislam_runs.hpp"
 
+using namespace sextant::runner;
+
 int main(int argc, char** argv) {
-  using namespace sextant::runner;
-  return family_main(argc, argv, "sextant-vislam",
-                     "sextant-vislam: visual-inertial SLAM on SE(3) on .npz stereo+IMU data or the simulated stereo car",
-                     is_vislam_dataset, "stereo-vi and .npz files", run_vislam, {"stereo-vi"});
+  return family_main(
+      argc, argv, "sextant-vislam",
+      "sextant-vislam: visual-inertial SLAM on SE(3) on .npz stereo+IMU data or the simulated stereo car",
+      is_vislam_dataset, "stereo-vi and .npz files",
+      [](const CliOptions& options, const std::string& dataset, const std::vector<BackendKind>& kinds,
+         const RunnerConfig& config) { return run_vislam(options.output, dataset, kinds, config); },
+      {"stereo-vi"});
 }

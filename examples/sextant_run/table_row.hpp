@@ -1,0 +1,50 @@
+#pragma once
+// A row of the comparison table: which back-end and its scores. Apart from table.hpp (which needs the
+// config) so that the programs' main() units know the rows without the config (docs/build_times.md).
+#include <optional>
+#include <sextant/eval/experiment.hpp>
+#include <string>
+#include <vector>
+
+namespace sextant::runner {
+
+enum class BackendKind { ekf, seif, graph, fastslam1, fastslam2 };
+
+inline const std::vector<BackendKind>& all_backends() {
+  static const std::vector<BackendKind> all = {BackendKind::ekf, BackendKind::seif, BackendKind::graph,
+                                               BackendKind::fastslam1, BackendKind::fastslam2};
+  return all;
+}
+
+/// The command-line name of a back-end (also the prefix of its output files).
+inline std::string backend_key(BackendKind kind) {
+  switch (kind) {
+    case BackendKind::ekf: return "ekf";
+    case BackendKind::seif: return "seif";
+    case BackendKind::graph: return "graph";
+    case BackendKind::fastslam1: return "fastslam1";
+    case BackendKind::fastslam2: return "fastslam2";
+  }
+  return "?";
+}
+
+/// How a data set is scored: which pose entries are position, the degrees of freedom for NEES.
+struct Scoring {
+  int position_dim, pose_dof, landmark_dof;
+};
+
+/// How a run with withheld ids associated its measurements (eval::AssociationScore).
+struct AssociationRow {
+  double precision, recall;
+  std::size_t wrong, duplicates, discarded;
+};
+
+/// A line of the comparison table.
+struct TableRow {
+  std::string dataset, backend, label;
+  eval::Summary summary;
+  int runs = 1;
+  std::optional<AssociationRow> association;
+};
+
+}  // namespace sextant::runner
