@@ -50,7 +50,6 @@ case "$mode" in
     [ "$mode" = test-slow ] && label=(-L slow)
     cd "$build" && exec ctest --output-on-failure -j"$jobs" "${label[@]}" "$@" ;;
   test-sanitize)
-    bash cmake/install_deps.sh clang  # clang builds these in about 0.7 of gcc's time (docs/reliability.md)
     build=${SEXTANT_SANITIZE_BUILD_DIR:-build-sanitize}
     cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DCMAKE_CXX_COMPILER=clang++ \
           -DSEXTANT_SANITIZE=address,undefined \
@@ -68,7 +67,6 @@ case "$mode" in
     export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1}
     cd "$build" && exec ctest --output-on-failure -j"$jobs" -R "^(ConcurrentReads|MonteCarlo)" "$@" ;;
   fuzz)
-    bash cmake/install_deps.sh clang  # libFuzzer comes with clang's runtime libraries
     build=${SEXTANT_FUZZ_BUILD_DIR:-build-fuzz}
     cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DCMAKE_CXX_COMPILER=clang++ \
           -DSEXTANT_BUILD_FUZZERS=ON -DSEXTANT_BUILD_TESTS=OFF -DSEXTANT_BUILD_EXAMPLES=OFF -DSEXTANT_BUILD_BENCHMARKS=OFF \

@@ -2,9 +2,10 @@
 # Installs the Debian packages sextant needs to build, test and benchmark, if any are missing.
 set -euo pipefail
 # libmrpt-dev: rawlogs, 3D scenes, CConfigFile; mrpt-common: the kf-slam demo rawlogs; libzip-dev: .npz files;
-# libopencv-dev: the visual front-end (sextant::vision); python3-matplotlib: --plots
-packages=(cmake make g++ libeigen3-dev libboost-dev libgtest-dev libbenchmark-dev libcli11-dev libsuitesparse-dev libceres-dev
-          libmrpt-dev mrpt-common libzip-dev libopencv-dev python3-matplotlib "$@")  # "$@": a mode's extras (./run.sh fuzz: clang)
+# libopencv-dev: the visual front-end (sextant::vision); python3-matplotlib: --plots; clang: run.sh's
+# compiler (docs/build_times.md), g++ the benchmarks' and the thread-sanitizer build's
+packages=(cmake make g++ clang libeigen3-dev libboost-dev libgtest-dev libbenchmark-dev libcli11-dev libsuitesparse-dev libceres-dev
+          libmrpt-dev mrpt-common libzip-dev libopencv-dev python3-matplotlib "$@")  # "$@": extra packages to install
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
