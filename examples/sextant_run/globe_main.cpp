@@ -9,7 +9,7 @@ int main(int argc, char** argv) {
   return family_main(
       argc, argv, "sextant-globe",
       "sextant-globe: the thesis's 12D camera around a simulated globe, every back-end through the landmark pool",
-      [](const std::string& dataset) { return dataset == "globe"; }, "only the globe",
+      is_globe_dataset, "only the globe",
       [](const CliOptions& options, const std::string&, const std::vector<BackendKind>& kinds,
          const RunnerConfig& config) { return run_globe(options.output, kinds, config); },
       {"globe"});

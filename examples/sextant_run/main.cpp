@@ -55,8 +55,6 @@ std::vector<TableRow> run_main_dataset(const CliOptions& options, const std::str
   return run_rawlog(options.output, dataset, kinds, config);
 }
 
-bool is_globe_dataset(const std::string& dataset) { return dataset == "globe"; }
-
 /// A family of data sets that runs in a program of its own next to sextant-run.
 struct HandOver {
   bool (*is_its)(const std::string&);

@@ -22,6 +22,9 @@ struct CliOptions {
   RunOptions output;
 };
 
+/// A data set of sextant-globe: the simulated globe.
+inline bool is_globe_dataset(const std::string& dataset) { return dataset == "globe"; }
+
 /// A data set of sextant-vislam: the simulated stereo car or a .npz file.
 inline bool is_vislam_dataset(const std::string& dataset) {
   return dataset == "stereo-vi" || std::filesystem::path(dataset).extension() == ".npz";
