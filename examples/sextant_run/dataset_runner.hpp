@@ -21,11 +21,11 @@ inline std::string directory_name(const std::string& dataset) {
 /// Writes the files of every run of one data set and, if asked, the plots.
 template <class Dataset>
 void write_dataset_outputs(const RunOptions& options, const std::string& dataset, const Dataset& data,
-                           const std::vector<std::pair<BackendKind, BackendRun<Dataset>>>& runs, const Scoring& scoring,
+                           const std::vector<std::pair<BackendKind, BackendRun<Dataset>>>& runs,
                            const RunnerConfig& config, const char* unit) {
   if (options.out.empty()) return;
   const auto dir = std::filesystem::path(options.out) / directory_name(dataset);
-  for (const auto& [kind, run] : runs) write_run_outputs(dir, kind, run, data, scoring, config);
+  for (const auto& [kind, run] : runs) write_run_outputs(dir, kind, run, data, config);
   std::printf("wrote per-step CSV, map CSV, TUM trajectories and .3Dscene files to %s\n", dir.c_str());
   if (!options.plots) return;
   run_plot_script("plot_run.py", dir, unit);
@@ -43,12 +43,12 @@ void print_dataset_header(const std::string& name, const Dataset& data, const ch
 template <class Dataset>
 std::vector<TableRow> run_dataset_rows(const RunOptions& options, const std::string& name, const Dataset& data,
                                        const std::vector<BackendKind>& kinds, const RunnerConfig& config,
-                                       const Scoring& scoring, const char* unit) {
+                                       const char* unit) {
   if (kinds.empty()) return {};
   std::vector<std::pair<BackendKind, BackendRun<Dataset>>> runs;
-  auto rows = run_on_rawlog(name, data, kinds, config, scoring, runs);
+  auto rows = run_on_rawlog(name, data, kinds, config, runs);
   for (const auto& row : rows) print_row(row);
-  write_dataset_outputs(options, name, data, runs, scoring, config, unit);
+  write_dataset_outputs(options, name, data, runs, config, unit);
   return rows;
 }
 
@@ -56,9 +56,9 @@ std::vector<TableRow> run_dataset_rows(const RunOptions& options, const std::str
 template <class Dataset>
 std::vector<TableRow> run_dataset(const RunOptions& options, const std::string& name, const Dataset& data,
                                   const std::vector<BackendKind>& kinds, const RunnerConfig& config,
-                                  const Scoring& scoring, const char* unit) {
+                                  const char* unit) {
   print_dataset_header(name, data, unit);
-  return run_dataset_rows(options, name, data, kinds, config, scoring, unit);
+  return run_dataset_rows(options, name, data, kinds, config, unit);
 }
 
 }  // namespace sextant::runner

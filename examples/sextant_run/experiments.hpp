@@ -8,11 +8,11 @@
 #include <sextant/eval/particle_association.hpp>
 #include <sextant/eval/withheld_ids.hpp>
 #include <sextant/io/landmark_dataset.hpp>
-#include <sextant/models/se2_world_frame.hpp>
 #include <string>
 #include <type_traits>
 #include <vector>
 
+#include "backend_factory.hpp"
 #include "progress_bar.hpp"
 #include "runner_config.hpp"
 #include "table.hpp"
@@ -46,19 +46,11 @@ inline bool left_out(BackendKind kind, const RunnerConfig& c, const std::string&
   return true;
 }
 
-/// Whether a filter linearizes at first estimates (RunnerConfig::ekf_first_estimates, seif_first_estimates).
-template <class Motion>
-bool use_first_estimates(FirstEstimates choice) {
-  if (choice == FirstEstimates::automatic) return std::is_same_v<typename Motion::Space, Se2WorldSpace>;
-  return choice == FirstEstimates::on;
-}
-
 /// Runs one back-end over the data set; on_step(k) after every step.
 template <class Dataset, class OnStep>
-BackendRun<Dataset> run_backend(BackendKind kind, const Dataset& data, const RunnerConfig& c, const Scoring& scoring,
+BackendRun<Dataset> run_backend(const BackendChoice& choice, const Dataset& data, const RunnerConfig& c,
                                 OnStep on_step) {
-  using Motion = decltype(Dataset::motion);
-  using Sensor = decltype(Dataset::sensor);
+  constexpr Scoring scoring = scoring_of<Dataset>();
   BackendRun<Dataset> out;
   const auto finish = [&](auto& backend, auto run) {
     out.run = std::move(run);
@@ -75,57 +67,31 @@ BackendRun<Dataset> run_backend(BackendKind kind, const Dataset& data, const Run
     else
       return eval::evaluate_run(backend, data, scoring.position_dim, on_step);
   };
-  /// A filter run with the data set's ids, or with them withheld and associated.
-  const auto run_filter = [&](auto& backend) {
-    if (!c.association.method) return finish(backend, evaluate(backend));
-    AssociationOptions options = c.association.options;
-    options.method = *c.association.method;
-    eval::WithheldIds withheld(backend, data.sensor, options);
-    finish(withheld, evaluate(withheld));
-    out.association = withheld.score();
-  };
-  switch (kind) {
-    case BackendKind::ekf: {
-      EkfOptions o = c.ekf;
-      o.first_estimate_jacobians = use_first_estimates<Motion>(c.ekf_first_estimates);
-      EkfSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, o);
-      run_filter(b);
-      break;
-    }
-    case BackendKind::seif: {
-      SeifOptions o = c.seif;
-      o.first_estimate_jacobians = use_first_estimates<Motion>(c.seif_first_estimates);
-      SeifSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, o);
-      run_filter(b);
-      break;
-    }
-    case BackendKind::graph: {
-      GraphSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, c.graph);
-      finish(b, evaluate(b));
-      break;
-    }
-    case BackendKind::fastslam1:
-    case BackendKind::fastslam2: {
-      FastSlamOptions o = c.fastslam;
-      o.version = kind == BackendKind::fastslam1 ? FastSlamVersion::v1 : FastSlamVersion::v2;
-      FastSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, o);
-      if (c.association.method) {  // per-particle maximum likelihood, whatever the method
-        eval::ParticleAssociation withheld(b);
+  with_backend(choice, data.motion, data.sensor, data.prior, [&](auto& backend) {
+    if (c.association.method && associates(choice.kind)) {  // the ids withheld and associated
+      if constexpr (requires { backend.particles(); }) {   // per particle by maximum likelihood, whatever the method
+        eval::ParticleAssociation withheld(backend);
+        return finish(withheld, evaluate(withheld));
+      } else if constexpr (requires { backend.joint_marginal(std::span<const LandmarkId>{}); }) {
+        AssociationOptions options = c.association.options;
+        options.method = *c.association.method;
+        eval::WithheldIds withheld(backend, data.sensor, options);
         finish(withheld, evaluate(withheld));
-      } else {
-        finish(b, evaluate(b));
+        out.association = withheld.score();
+        return;
       }
-      break;
     }
-  }
+    finish(backend, evaluate(backend));
+  });
   return out;
 }
 
 /// Every chosen back-end on one rawlog: one run each; `first_runs` receives them for the outputs.
 template <class Dataset>
 std::vector<TableRow> run_on_rawlog(const std::string& name, const Dataset& data, const std::vector<BackendKind>& kinds,
-                                    const RunnerConfig& c, const Scoring& scoring,
+                                    const RunnerConfig& c,
                                     std::vector<std::pair<BackendKind, BackendRun<Dataset>>>& first_runs) {
+  constexpr Scoring scoring = scoring_of<Dataset>();
   std::vector<TableRow> rows;
   if constexpr (requires { data.ids; }) {
     if (data.ids == io::LandmarkIds::absent && !c.association.method)
@@ -134,11 +100,12 @@ std::vector<TableRow> run_on_rawlog(const std::string& name, const Dataset& data
       std::printf("%s: the log has no landmark ids; each measurement took the id of its nearest true landmark, %s\n",
                   name.c_str(), c.association.method ? "which scores the association" : "an oracle association");
   }
-  for (BackendKind kind : kinds) {
+  for (const auto& choice : backend_choices<std::decay_t<decltype(Dataset::motion)>>(kinds, c)) {
+    const BackendKind kind = choice.kind;
     if (left_out(kind, c, name)) continue;
-    ProgressBar progress(name + ": " + backend_key(kind), data.steps.size());
-    auto result = run_backend(kind, data, c, scoring, [&](std::size_t) { progress.advance(); });
-    rows.push_back({name, backend_key(kind), backend_label(kind, c),
+    ProgressBar progress(name + ": " + choice.key, data.steps.size());
+    auto result = run_backend(choice, data, c, [&](std::size_t) { progress.advance(); });
+    rows.push_back({name, choice.key, choice.label,
                     eval::summarize(std::vector{result.run}, scoring.pose_dof, scoring.landmark_dof), 1, std::nullopt});
     if (const auto& a = result.association) rows.back().association = association_row(*a);
     if constexpr (requires { data.has_ground_truth(); })
@@ -151,18 +118,20 @@ std::vector<TableRow> run_on_rawlog(const std::string& name, const Dataset& data
 /// Every chosen back-end on `runs` simulated ships (seeds in parallel); the first seed's run of
 /// each back-end goes to `first_runs`.
 template <class Dataset>
-std::vector<TableRow> run_on_ship(const std::vector<BackendKind>& kinds, const RunnerConfig& c, const Scoring& scoring,
+std::vector<TableRow> run_on_ship(const std::vector<BackendKind>& kinds, const RunnerConfig& c,
                                   std::vector<std::pair<BackendKind, BackendRun<Dataset>>>& first_runs) {
+  constexpr Scoring scoring = scoring_of<Dataset>();
   std::vector<TableRow> rows;
-  for (BackendKind kind : kinds) {
+  for (const auto& choice : backend_choices<std::decay_t<decltype(Dataset::motion)>>(kinds, c)) {
+    const BackendKind kind = choice.kind;
     if (left_out(kind, c, "ship")) continue;
-    ProgressBar progress("ship: " + backend_key(kind), static_cast<std::size_t>(c.ship_runs));
+    ProgressBar progress("ship: " + choice.key, static_cast<std::size_t>(c.ship_runs));
     std::optional<BackendRun<Dataset>> first;
     std::mutex first_mutex;
     const auto runs = eval::monte_carlo(c.ship_runs, c.ship.seed, [&](std::uint64_t seed) {
       sim::Ship2DOptions o = c.ship;
       o.seed = seed;
-      auto result = run_backend(kind, sim::simulate_ship_2d(o), c, scoring, [](std::size_t) {});
+      auto result = run_backend(choice, sim::simulate_ship_2d(o), c, [](std::size_t) {});
       progress.advance();
       if (seed == c.ship.seed) {
         std::lock_guard lock(first_mutex);
@@ -170,7 +139,7 @@ std::vector<TableRow> run_on_ship(const std::vector<BackendKind>& kinds, const R
       }
       return result.run;
     });
-    rows.push_back({"ship", backend_key(kind), backend_label(kind, c),
+    rows.push_back({"ship", choice.key, choice.label,
                     eval::summarize(runs, scoring.pose_dof, scoring.landmark_dof), c.ship_runs, std::nullopt});
     if (const auto& a = first->association)  // the first seed's
       rows.back().association = association_row(*a);

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "backend_factory.hpp"
+#include "dataset_registry.hpp"
 #include "globe_runs.hpp"
 #include "plot_script.hpp"
 #include "progress_bar.hpp"
@@ -95,21 +97,17 @@ void score_smoothed_marginals(const Graph& graph, const Dataset& data, const Run
   out.marginal_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-/// GraphSLAM as the thesis ran it: the steps recorded through the pool, then windowed
-/// initialization (windows of 50 steps, 5 iterations each) and global Gauss-Newton updates, scored
-/// after each (Table 10); the row gives the last.
-GlobeRun run_graph(const Dataset& data, const RunnerConfig& c) {
-  GraphOptions options = c.graph;
-  options.max_iterations = 1;  // one global update per optimize()
-  options.window = 50;
-  options.window_iterations = 5;
-  GraphSlam<Motion, Sensor> graph(data.motion, data.sensor, data.prior, options);
-  ProgressBar progress("globe: graph", data.steps.size() + static_cast<std::size_t>(c.globe.graph_updates));
+/// GraphSLAM as the thesis ran it (globe_choices): the steps recorded through the pool, then
+/// windowed initialization and global Gauss-Newton updates, scored after each (Table 10); the row
+/// gives the last.
+template <class Graph>
+GlobeRun run_graph(Graph& graph, const Dataset& data, const RunnerConfig& c, std::string key, std::string label) {
+  ProgressBar progress("globe: " + key, data.steps.size() + static_cast<std::size_t>(c.globe.graph_updates));
   auto run = eval::run_through_pool(graph, data.steps, c.globe.pool, 0,
-                                    [&](std::size_t, const GraphSlam<Motion, Sensor>&) { progress.advance(); });
+                                    [&](std::size_t, const Graph&) { progress.advance(); });
   GlobeRun out;
-  out.key = "graph";
-  out.label = "GraphSLAM, windows 50 x 5";
+  out.key = std::move(key);
+  out.label = std::move(label);
   out.pool = std::move(run.pool);
   out.total_seconds = run.total_seconds;
   for (int update = 0; update < c.globe.graph_updates; ++update) {
@@ -131,35 +129,42 @@ GlobeRun run_graph(const Dataset& data, const RunnerConfig& c) {
   return out;
 }
 
+/// The globe's back-end configurations: SEIF once per [globe] seif_active; GraphSLAM as the thesis
+/// ran it, windowed initialization (windows of 50 steps, 5 iterations each), then one global update
+/// per optimize().
+std::vector<BackendChoice> globe_choices(const std::vector<BackendKind>& kinds, const RunnerConfig& c) {
+  std::vector<BackendChoice> choices;
+  for (auto choice : backend_choices<Motion>(kinds, c)) {
+    if (choice.kind == BackendKind::seif) {
+      for (std::size_t active : c.globe.seif_active) {
+        const std::string name = active ? std::to_string(active) : "all";
+        choice.seif.max_active = active;
+        choice.key = "seif" + name;
+        choice.label = "SEIF-SLAM, " + name + " active";
+        choices.push_back(choice);
+      }
+      continue;
+    }
+    if (choice.kind == BackendKind::graph) {
+      choice.graph.max_iterations = 1;
+      choice.graph.window = 50;
+      choice.graph.window_iterations = 5;
+      choice.label = "GraphSLAM, windows 50 x 5";
+    }
+    choices.push_back(std::move(choice));
+  }
+  return choices;
+}
+
 std::vector<GlobeRun> run_backends(const Dataset& data, const std::vector<BackendKind>& kinds, const RunnerConfig& c) {
   std::vector<GlobeRun> runs;
-  for (BackendKind kind : kinds) {
-    switch (kind) {
-      case BackendKind::ekf: {
-        EkfSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, c.ekf);
-        runs.push_back(run_filter(b, data, c, "ekf", "EKF-SLAM"));
-        break;
-      }
-      case BackendKind::seif:
-        for (std::size_t active : c.globe.seif_active) {
-          SeifOptions o = c.seif;
-          o.max_active = active;
-          SeifSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, o);
-          const std::string name = active ? std::to_string(active) : "all";
-          runs.push_back(run_filter(b, data, c, "seif" + name, "SEIF-SLAM, " + name + " active"));
-        }
-        break;
-      case BackendKind::graph: runs.push_back(run_graph(data, c)); break;
-      case BackendKind::fastslam1:
-      case BackendKind::fastslam2: {
-        FastSlamOptions o = c.fastslam;
-        o.version = kind == BackendKind::fastslam1 ? FastSlamVersion::v1 : FastSlamVersion::v2;
-        FastSlam<Motion, Sensor> b(data.motion, data.sensor, data.prior, o);
-        runs.push_back(run_filter(b, data, c, backend_key(kind), backend_label(kind, c)));
-        break;
-      }
-    }
-  }
+  for (const auto& choice : globe_choices(kinds, c))
+    with_backend(choice, data.motion, data.sensor, data.prior, [&](auto& backend) {
+      if constexpr (requires { backend.optimize(); })
+        runs.push_back(run_graph(backend, data, c, choice.key, choice.label));
+      else
+        runs.push_back(run_filter(backend, data, c, choice.key, choice.label));
+    });
   return runs;
 }
 
@@ -283,7 +288,9 @@ std::vector<TableRow> run_globe_dataset(const RunOptions& options, const std::st
   return rows;
 }
 
-std::vector<TableRow> run_globe(const RunOptions& options, const std::vector<BackendKind>& kinds,
+namespace {
+
+std::vector<TableRow> run_globe(const CliOptions& cli, const std::string&, const std::vector<BackendKind>& kinds,
                                 const RunnerConfig& config) {
   const auto data = sim::simulate_globe_camera(globe_options(config.globe));
   std::printf("\n== globe: the thesis's 12D camera around a simulated globe, %d steps, %zu points, %d features per "
@@ -291,7 +298,11 @@ std::vector<TableRow> run_globe(const RunOptions& options, const std::vector<Bac
               config.globe.steps, data.true_landmarks.size(), config.globe.features_per_frame,
               config.globe.pool.max_landmarks, config.globe.pool.max_new_per_step,
               static_cast<unsigned long long>(config.globe.seed));
-  return run_globe_dataset(options, "globe", data, kinds, config);
+  return run_globe_dataset(cli.output, "globe", data, kinds, config);
 }
+
+const RegisterDatasetRun registration{"globe", run_globe};
+
+}  // namespace
 
 }  // namespace sextant::runner

@@ -35,7 +35,8 @@ io::TumPose tum_pose(double timestamp, const State& x) {
 }
 
 template <class Dataset>
-void write_steps_csv(const std::string& path, const BackendRun<Dataset>& r, const Scoring& scoring) {
+void write_steps_csv(const std::string& path, const BackendRun<Dataset>& r) {
+  constexpr Scoring scoring = scoring_of<Dataset>();
   std::vector<std::string> header{"step", "x", "y", "z", "pose_error", "pose_nees", "nees_bound_95", "seconds"};
   io::CsvWriter csv(path, header);
   const double bound = eval::nees_upper_bound(scoring.pose_dof, 0.95);
@@ -85,10 +86,10 @@ mrpt_io::SceneContent scene_content(const BackendRun<Dataset>& r, const Dataset&
 /// All files of one back-end on one data set, into `dir`.
 template <class Dataset>
 void write_run_outputs(const std::filesystem::path& dir, BackendKind kind, const BackendRun<Dataset>& r,
-                       const Dataset& data, const Scoring& scoring, const RunnerConfig& c) {
+                       const Dataset& data, const RunnerConfig& c) {
   std::filesystem::create_directories(dir);
   const std::string key = backend_key(kind);
-  write_steps_csv((dir / (key + "_steps.csv")).string(), r, scoring);
+  write_steps_csv((dir / (key + "_steps.csv")).string(), r);
   write_map_csv((dir / (key + "_map.csv")).string(), r, data);
   std::vector<io::TumPose> estimated, truth;
   for (std::size_t k = 0; k < r.run.trajectory.size(); ++k) {

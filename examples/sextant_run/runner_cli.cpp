@@ -5,7 +5,9 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 
+#include "dataset_registry.hpp"
 #include "runner_config.hpp"
 #include "table.hpp"
 
@@ -13,14 +15,11 @@ namespace sextant::runner {
 namespace {
 
 /// Declares the options every program takes.
-void add_runner_options(CLI::App& app, CliOptions& options) {
+void add_runner_options(CLI::App& app, CliOptions& options, const char* program) {
   app.add_option("--backend,-b", options.backends, "ekf|seif|graph|fastslam1|fastslam2|all (repeatable)")
       ->delimiter(',')
       ->capture_default_str();
-  app.add_option("--dataset,-d", options.datasets,
-                 "ship | globe | globe-stereo | stereo:<dir> | stereo-vi | <file.npz> | mrpt-demos | <file.rawlog> | <file.txt> (iSAM/GTSAM planar text) | mrclam:<dir>:<robot 1-5|all> "
-                 "(repeatable; default: ship and the "
-                 "MRPT kf-slam demos)");
+  app.add_option("--dataset,-d", options.datasets, dataset_help(program));
   app.add_option("--config,-c", options.config, "ini file (MRPT CConfigFile) with [ship] [globe] [vislam] [rawlog] [ekf] [seif] [graph] "
                                                 "[fastslam] [scene] keys; see --print-config");
   app.add_option("--out,-o", options.output.out, "directory for per-step CSV, TUM, .3Dscene files and summary.json");
@@ -87,7 +86,7 @@ int runner_main(int argc, char** argv, const char* program, const std::string& d
                 const std::function<int(CliOptions&)>& run) {
   CLI::App app{description};
   CliOptions options;
-  add_runner_options(app, options);
+  add_runner_options(app, options, program);
   CLI11_PARSE(app, argc, argv);
   if (options.print_config) {
     std::fputs(documented_defaults().c_str(), stdout);
@@ -99,32 +98,6 @@ int runner_main(int argc, char** argv, const char* program, const std::string& d
     std::fprintf(stderr, "%s: %s\n", program, one_line(e.what()).c_str());
     return 1;
   }
-}
-
-int run_datasets(CliOptions& options, const char* program, bool (*is_its)(const std::string&), const char* what,
-                 DatasetRun run_one, const std::vector<std::string>& defaults,
-                 std::vector<std::string> (*expand)(const std::vector<std::string>&)) {
-  if (options.datasets.empty()) options.datasets = defaults;
-  for (const auto& dataset : options.datasets)
-    if (!is_its(dataset))
-      throw invalid_input_error("--dataset " + dataset + ": " + program + " runs " + what + " (sextant-run runs the rest)");
-  const RunnerConfig config = load_runner_config(options);
-  const auto kinds = parse_backends(options.backends);
-  std::vector<TableRow> rows;
-  for (const auto& dataset : expand ? expand(options.datasets) : options.datasets) {
-    auto part = run_one(options, dataset, kinds, config);
-    rows.insert(rows.end(), part.begin(), part.end());
-  }
-  finish_run(options, rows);
-  return 0;
-}
-
-int family_main(int argc, char** argv, const char* program, const std::string& description,
-                bool (*is_its)(const std::string&), const char* what, DatasetRun run_one,
-                const std::vector<std::string>& defaults) {
-  return runner_main(argc, argv, program, description, [&](CliOptions& options) {
-    return run_datasets(options, program, is_its, what, run_one, defaults);
-  });
 }
 
 }  // namespace sextant::runner

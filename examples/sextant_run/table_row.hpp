@@ -4,6 +4,7 @@
 #include <optional>
 #include <sextant/eval/experiment.hpp>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace sextant::runner {
@@ -32,6 +33,17 @@ inline std::string backend_key(BackendKind kind) {
 struct Scoring {
   int position_dim, pose_dof, landmark_dof;
 };
+
+/// A data set's scoring, from its models: landmarks live where the robot's position does, so the
+/// position is the pose's leading landmark-dimension entries; the pose NEES has the motion model's
+/// dof, the map's the landmark's.
+template <class Dataset>
+constexpr Scoring scoring_of() {
+  using Motion = std::decay_t<decltype(Dataset::motion)>;
+  using Sensor = std::decay_t<decltype(Dataset::sensor)>;
+  constexpr int landmark = Sensor::Landmark::RowsAtCompileTime;
+  return {landmark, Motion::kDim, landmark};
+}
 
 /// How a run with withheld ids associated its measurements (eval::AssociationScore).
 struct AssociationRow {

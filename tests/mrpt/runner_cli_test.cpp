@@ -330,4 +330,20 @@ TEST_F(RunnerCli, IsamTextWithoutGroundTruthIsTimedAndWrittenNotScored) {
   EXPECT_NE(text.str().find("\"pose_mae\": null"), std::string::npos) << text.str();
 }
 
+TEST_F(RunnerCli, TheDocsWorkedExampleFamilyRunsLikeAnyOther) {
+  // docs/runner.md's "Add your own dataset": sextant-run/run_square.cpp and one registry line give a
+  // family with the table, the files and one-line errors of every other (docs.runner_example keeps
+  // the docs equal to the file).
+  const auto out = dir / "square_out";
+  const auto r = run_runner("-d square:3 -b ekf,graph -o " + out.string(), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("== square:3: 328 steps, 40 landmarks in the ground truth"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("EKF-SLAM"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("GraphSLAM"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(out / "square:3" / "ekf_steps.csv"));
+  EXPECT_TRUE(fs::exists(out / "square:3" / "graph.3Dscene"));
+  expect_one_line_error("-d square:x", {"--dataset square:x", "whole number", "square:<seed>"});
+  expect_one_line_error("-d square -d globe", {"--dataset globe: runs alone", "sextant-globe"});
+}
+
 }  // namespace

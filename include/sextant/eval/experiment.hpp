@@ -84,19 +84,15 @@ void add_aligned_errors(Summary& out, const Map& map, const Dataset& dataset, in
   }
   out.map_error_aligned = aligned_position_errors(estimated, true_points, static_cast<int>(Point::RowsAtCompileTime));
 }
-/// predict + update over every step of the data set, each timed into out.seconds and
-/// out.total_seconds; after(k) once step k is done.
+/// predict + update over every step of the data set (for_each_step), each timed into out.seconds
+/// and out.total_seconds; after(k) once step k is done.
 template <class Backend, class Dataset, class Summary, class After>
 void run_timed_steps(Backend& backend, const Dataset& dataset, Summary& out, After after) {
-  using Clock = std::chrono::steady_clock;
-  for (const auto& step : dataset.steps) {
-    const auto start = Clock::now();
-    backend.predict(step.control, step.dt);
-    backend.update(step.observations);
-    out.seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-    out.total_seconds += out.seconds.back();
-    after(out.seconds.size() - 1);
-  }
+  for_each_step(backend, dataset.steps, PlainUpdate{}, [&](std::size_t k, double seconds, const UpdateResult&) {
+    out.seconds.push_back(seconds);
+    out.total_seconds += seconds;
+    after(k);
+  });
 }
 
 /// Full SLAM's optimize(), its time added to out.total_seconds.

@@ -4,24 +4,18 @@
 /// pool's bookkeeping of every step, and the pose with its covariance every few steps (a SEIF's
 /// covariance needs a factorization of Omega, which costs more than its step once the map fills in).
 
-#include <chrono>
+#include <limits>
 #include <span>
 #include <utility>
 #include <vector>
 
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/landmark_pool_policy.hpp"
+#include "sextant/core/pose_mean.hpp"
+#include "sextant/eval/metrics.hpp"
+#include "sextant/eval/runner.hpp"
 
 namespace sextant::eval {
-
-/// The pose mean of any back-end, by pose_mean() where it has one (SEIF), else pose().mean.
-template <class Backend>
-typename Backend::State pose_mean_of(const Backend& backend) {
-  if constexpr (requires { backend.pose_mean(); })
-    return backend.pose_mean();
-  else
-    return backend.pose().mean;
-}
 
 /// Whether step k of `count` has its covariance recorded: every period-th step and the last
 /// (period 0: none).
@@ -35,39 +29,60 @@ struct SampledPose {
   PoseEstimate estimate;
 };
 
+/// Mean NEES of sampled poses against reference poses (reference[step] is the true pose after that
+/// step), the error Space::minus(reference, estimate); +infinity where a covariance is not positive
+/// definite; NaN for none.
+template <class Space, class PoseEstimate, class Pose>
+double sampled_pose_anees(const std::vector<SampledPose<PoseEstimate>>& poses, const std::vector<Pose>& reference) {
+  if (poses.empty()) return std::numeric_limits<double>::quiet_NaN();
+  double sum = 0.0;
+  for (const auto& p : poses) sum += nees_or_infinity(Space::minus(reference.at(p.step), p.estimate.mean), p.estimate.cov);
+  return sum / static_cast<double>(poses.size());
+}
+
+/// What the updates of a run reported, added up over its steps.
+struct UpdateTotals {
+  std::size_t corrected = 0, initialized = 0, rejected = 0, unusable = 0;
+  void add(const UpdateResult& r) {
+    corrected += r.corrected;
+    initialized += r.initialized;
+    rejected += r.rejected.size();
+    unusable += r.unusable.size();
+  }
+};
+
 template <class State, class PoseEstimate>
 struct PooledRun {
   std::vector<State> means;                       ///< pose mean after each step
   std::vector<SampledPose<PoseEstimate>> poses;   ///< mean and covariance after every period-th step and the last
   std::vector<double> seconds;                    ///< predict + evictions + update of each step
   std::vector<PoolStepRecord> pool;               ///< bookkeeping of each step
+  UpdateTotals updates;                           ///< what the updates reported, over all steps
   double total_seconds = 0.0;
 };
 
-/// For every step: predict, evict what the pool asks for, update with the admitted observations.
-/// covariance_period: record pose() after steps k with (k + 1) % period == 0 and after the last.
-/// on_step(k, backend) after step k. Timing excludes the recording.
+/// For every step (for_each_step): predict, evict what the pool asks for, update with the admitted
+/// observations. covariance_period: record pose() after steps k with (k + 1) % period == 0 and after
+/// the last. on_step(k, backend) after step k. Timing excludes the recording.
 template <class Backend, class Steps, class OnStep>
   requires SlamBackend<Backend>
 auto run_through_pool(Backend& backend, const Steps& steps, PoolLimits limits, std::size_t covariance_period,
                       OnStep&& on_step) {
-  using Clock = std::chrono::steady_clock;
   using Measurement = typename Backend::Measurement;
   PooledRun<typename Backend::State, decltype(backend.pose())> out;
   LandmarkPoolPolicy policy(limits);
   const std::size_t count = std::size(steps);
-  std::size_t k = 0;
-  for (const auto& step : steps) {
-    const auto start = Clock::now();
-    backend.predict(step.control, step.dt);
-    update_through_pool(backend, policy, std::span<const Observation<Measurement>>(step.observations), k);
-    out.seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-    out.total_seconds += out.seconds.back();
+  const auto through_pool = [&](Backend& b, const auto& step, std::size_t k) {
+    return update_through_pool(b, policy, std::span<const Observation<Measurement>>(step.observations), k);
+  };
+  for_each_step(backend, steps, through_pool, [&](std::size_t k, double seconds, const UpdateResult& result) {
+    out.seconds.push_back(seconds);
+    out.total_seconds += seconds;
+    out.updates.add(result);
     out.means.push_back(pose_mean_of(backend));
-    if (is_sampled_step(k, count, covariance_period))
-      out.poses.push_back({k, backend.pose()});
-    on_step(k++, std::as_const(backend));
-  }
+    if (is_sampled_step(k, count, covariance_period)) out.poses.push_back({k, backend.pose()});
+    on_step(k, std::as_const(backend));
+  });
   out.pool = policy.history();
   return out;
 }

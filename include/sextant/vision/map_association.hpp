@@ -20,7 +20,7 @@
 #include "sextant/core/error.hpp"
 #include "sextant/core/joint_marginal.hpp"
 #include "sextant/core/observation.hpp"
-#include "sextant/eval/pooled_run.hpp"
+#include "sextant/core/pose_mean.hpp"
 #include "sextant/vision/stereo_front_end.hpp"
 
 namespace sextant::vision {
@@ -80,7 +80,7 @@ struct FrameAssociation {
 template <class Backend, class Sensor>
 std::vector<PredictedLandmark> predict_landmarks_in_view(const Backend& backend, const Sensor& sensor, const StereoRig& rig,
                                                          int width, int height) {
-  const auto robot = eval::pose_mean_of(backend);
+  const auto robot = pose_mean_of(backend);
   std::vector<PredictedLandmark> out;
   for (const auto& landmark : backend.map()) {
     try {

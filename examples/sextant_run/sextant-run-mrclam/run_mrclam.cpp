@@ -6,6 +6,7 @@
 #include <sextant/io/mrclam_reader.hpp>
 #include <sextant/models/se2_world_frame.hpp>
 
+#include "dataset_registry.hpp"
 #include "dataset_runner.hpp"
 
 namespace sextant::runner {
@@ -84,11 +85,10 @@ std::pair<std::string, std::vector<int>> parse_spec(const std::string& spec) {
   throw invalid_input_error("--dataset mrclam:" + spec + ": robot must be a number 1-9 or all, got '" + robot + "'");
 }
 
-}  // namespace
-
-std::vector<TableRow> run_mrclam(const RunOptions& options, const std::string& spec, const std::vector<BackendKind>& kinds,
+std::vector<TableRow> run_mrclam(const CliOptions& cli, const std::string& dataset, const std::vector<BackendKind>& kinds,
                                  const RunnerConfig& config) {
-  const auto [directory, robots] = parse_spec(spec);
+  const RunOptions& options = cli.output;
+  const auto [directory, robots] = parse_spec(dataset.substr(std::string("mrclam:").size()));
   std::vector<TableRow> rows;
   for (const int robot : robots) {
     const auto data = io::read_mrclam(directory, robot, config.mrclam);
@@ -102,8 +102,8 @@ std::vector<TableRow> run_mrclam(const RunOptions& options, const std::string& s
     const auto [filters, others] = split_filters(kinds, config.mrclam_filters_in_world_frame);
     RunOptions plot_once = options;  // the plots of the directory are drawn after the second part
     plot_once.plots = options.plots && others.empty();
-    auto part = run_dataset_rows(plot_once, name, in_world_frame(data), filters, config, Scoring{2, 3, 2}, "m");
-    const auto rest = run_dataset_rows(options, name, data, others, config, Scoring{2, 3, 2}, "m");
+    auto part = run_dataset_rows(plot_once, name, in_world_frame(data), filters, config, "m");
+    const auto rest = run_dataset_rows(options, name, data, others, config, "m");
     part.insert(part.end(), rest.begin(), rest.end());
     const auto drift = score_dead_reckoning(data);
     std::printf("dead reckoning at the first sighting (%.1f s): heading off by %.3f rad, which no back-end can see; "
@@ -117,4 +117,7 @@ std::vector<TableRow> run_mrclam(const RunOptions& options, const std::string& s
   return rows;
 }
 
+const RegisterDatasetRun registration{"mrclam", run_mrclam};
+
+}  // namespace
 }  // namespace sextant::runner

@@ -19,11 +19,12 @@
 #include <string>
 #include <vector>
 
+#include "backend_factory.hpp"
 #include "plot_script.hpp"
 #include "progress_bar.hpp"
 #include "runner_config.hpp"
 #include "table.hpp"
-#include "vislam_runs.hpp"
+#include "dataset_registry.hpp"
 
 namespace sextant::runner {
 namespace {
@@ -52,7 +53,8 @@ struct ViRun {
   std::vector<Eigen::Matrix4d> means;
   std::vector<eval::SampledPose<Gaussian<Eigen::Matrix4d, 6>>> poses;
   std::vector<LandmarkEstimate<3>> map;
-  std::size_t in_state = 0, mapped = 0, corrected = 0, gated = 0, unusable = 0;
+  std::size_t in_state = 0;
+  eval::UpdateTotals updates;  ///< mapped (initialized), corrected, gated (rejected), unusable
   double seconds = 0.0;
   double rmse = std::nan(""), anees = std::nan("");
 };
@@ -100,27 +102,16 @@ ViData from_npz(const std::string& path, const RunnerConfig& c) {
 template <class Backend>
 ViRun run_backend(Backend& backend, const ViData& d, PoolLimits pool, std::size_t covariance_period, std::string key,
                   std::string label) {
+  ProgressBar progress(d.name + ": " + key, d.frames.size());
+  auto run = eval::run_through_pool(backend, d.frames, pool, covariance_period,
+                                    [&](std::size_t, const Backend&) { progress.advance(); });
   ViRun out;
   out.key = std::move(key);
   out.label = std::move(label);
-  ProgressBar progress(d.name + ": " + out.key, d.frames.size());
-  LandmarkPoolPolicy policy(pool);
-  const auto started = std::chrono::steady_clock::now();
-  std::size_t k = 0;
-  for (const auto& frame : d.frames) {
-    backend.predict(frame.control, frame.dt);
-    const auto result = update_through_pool(backend, policy, std::span<const Observation<Eigen::Vector4d>>(frame.observations), k);
-    out.corrected += result.corrected;
-    out.gated += result.rejected.size();
-    out.unusable += result.unusable.size();
-    out.mapped += result.initialized;
-    out.means.push_back(eval::pose_mean_of(backend));
-    if (eval::is_sampled_step(k, d.frames.size(), covariance_period))
-      out.poses.push_back({k, backend.pose()});
-    ++k;
-    progress.advance();
-  }
-  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  out.means = std::move(run.means);
+  out.poses = std::move(run.poses);
+  out.updates = run.updates;
+  out.seconds = run.total_seconds;
   out.in_state = backend.num_landmarks();
   if constexpr (requires { backend.map(); }) out.map = backend.map();
   return out;
@@ -132,16 +123,12 @@ ViRun run_backend(Backend& backend, const ViData& d, PoolLimits pool, std::size_
 /// The filters gate outliers; the graph down-weights them with a Huber loss at the same chi-square
 /// quantile (4 dof). No pool: a sparse graph does not need one, and a landmark marginalized while
 /// the poses are still dead reckoning would fix its factor at that linearization point.
-ViRun run_graph(const ViData& d, const RunnerConfig& c) {
-  GraphOptions options = c.graph;
-  options.levenberg_marquardt = true;
-  options.max_iterations = std::max(options.max_iterations, 30);
-  if (c.vislam.gate_probability > 0.0)
-    options.measurement_loss = {RobustKernel::huber, std::sqrt(chi_square_quantile(4, c.vislam.gate_probability))};
-  GraphSlam<Motion, Sensor> graph(d.motion, d.sensor, d.prior, options);
+/// (vislam_choices sets the options.)
+template <class Graph>
+ViRun run_graph(Graph& graph, const ViData& d, std::string key, std::string label) {
   const PoolLimits all{.max_landmarks = std::numeric_limits<std::size_t>::max() / 2,
                        .max_new_per_step = std::numeric_limits<std::size_t>::max() / 2};
-  ViRun out = run_backend(graph, d, all, 0, "graph", "GraphSLAM");
+  ViRun out = run_backend(graph, d, all, 0, std::move(key), std::move(label));
   const auto started = std::chrono::steady_clock::now();
   const auto summary = graph.optimize();
   out.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -162,40 +149,37 @@ ViRun dead_reckoning_row(const ViData& d) {
   return out;
 }
 
+/// The back-end configurations: the filters with the [vislam] gate, the EKF also with first-estimate
+/// Jacobians; GraphSLAM with Levenberg-Marquardt and a Huber loss at the gate's quantile (run_graph).
+std::vector<BackendChoice> vislam_choices(const std::vector<BackendKind>& kinds, const RunnerConfig& c) {
+  std::vector<BackendChoice> choices;
+  for (auto choice : backend_choices<Motion>(kinds, c)) {
+    choice.ekf.gate_probability = choice.seif.gate_probability = choice.fastslam.gate_probability =
+        c.vislam.gate_probability;
+    choice.graph.levenberg_marquardt = true;
+    choice.graph.max_iterations = std::max(choice.graph.max_iterations, 30);
+    if (c.vislam.gate_probability > 0.0)
+      choice.graph.measurement_loss = {RobustKernel::huber, std::sqrt(chi_square_quantile(4, c.vislam.gate_probability))};
+    choices.push_back(choice);
+    if (choice.kind != BackendKind::ekf) continue;
+    choice.ekf.first_estimate_jacobians = true;
+    choice.key = "ekf_fej";
+    choice.label = "EKF-SLAM, first-estimate Jacobians";
+    choices.push_back(std::move(choice));
+  }
+  return choices;
+}
+
 std::vector<ViRun> run_all(const ViData& d, const std::vector<BackendKind>& kinds, const RunnerConfig& c) {
   std::vector<ViRun> runs{dead_reckoning_row(d)};
-  EkfOptions ekf = c.ekf;
-  ekf.gate_probability = c.vislam.gate_probability;
-  for (BackendKind kind : kinds) {
-    switch (kind) {
-      case BackendKind::ekf: {
-        EkfSlam<Motion, Sensor> textbook(d.motion, d.sensor, d.prior, ekf);
-        runs.push_back(run_backend(textbook, d, c.vislam.pool, 1, "ekf", "EKF-SLAM"));
-        EkfOptions first = ekf;
-        first.first_estimate_jacobians = true;
-        EkfSlam<Motion, Sensor> first_estimates(d.motion, d.sensor, d.prior, first);
-        runs.push_back(run_backend(first_estimates, d, c.vislam.pool, 1, "ekf_fej", "EKF-SLAM, first-estimate Jacobians"));
-        break;
-      }
-      case BackendKind::seif: {
-        SeifOptions o = c.seif;
-        o.gate_probability = c.vislam.gate_probability;
-        SeifSlam<Motion, Sensor> seif(d.motion, d.sensor, d.prior, o);
-        runs.push_back(run_backend(seif, d, c.vislam.pool, 10, "seif", backend_label(kind, c)));
-        break;
-      }
-      case BackendKind::graph: runs.push_back(run_graph(d, c)); break;
-      case BackendKind::fastslam1:
-      case BackendKind::fastslam2: {
-        FastSlamOptions o = c.fastslam;
-        o.gate_probability = c.vislam.gate_probability;
-        o.version = kind == BackendKind::fastslam1 ? FastSlamVersion::v1 : FastSlamVersion::v2;
-        FastSlam<Motion, Sensor> fast(d.motion, d.sensor, d.prior, o);
-        runs.push_back(run_backend(fast, d, c.vislam.pool, 10, backend_key(kind), backend_label(kind, c)));
-        break;
-      }
-    }
-  }
+  for (const auto& choice : vislam_choices(kinds, c))
+    with_backend(choice, d.motion, d.sensor, d.prior, [&](auto& backend) {
+      if constexpr (requires { backend.optimize(); })
+        runs.push_back(run_graph(backend, d, choice.key, choice.label));
+      else  // the EKF's pose covariance after every frame, the others' every 10th (a SEIF's costs a factorization)
+        runs.push_back(run_backend(backend, d, c.vislam.pool, choice.kind == BackendKind::ekf ? 1 : 10, choice.key,
+                                   choice.label));
+    });
   return runs;
 }
 
@@ -213,12 +197,7 @@ void score(ViRun& r, const ViData& d) {
     squared += (se3::translation(r.means[k]) - se3::translation(d.reference[k])).squaredNorm();
   r.rmse = std::sqrt(squared / static_cast<double>(r.means.size()));
   if (!d.reference_is_truth || r.poses.empty()) return;
-  double nees = 0.0;
-  for (const auto& p : r.poses) {
-    const se3::Vector6d e = Se3Space::minus(d.reference[p.step], p.estimate.mean);
-    nees += e.dot(p.estimate.cov.ldlt().solve(e));
-  }
-  r.anees = nees / static_cast<double>(r.poses.size());
+  r.anees = eval::sampled_pose_anees<Se3Space>(r.poses, d.reference);
 }
 
 std::string number_or_dash(double value, const char* format) {
@@ -234,7 +213,7 @@ void print_table(const ViData& d, const std::vector<ViRun>& runs) {
               "corrected", "gated", "unusable", "RMSE [m]", "vs DR", "pose ANEES", "ms/frame");
   for (const auto& r : runs) {
     std::printf("%-38s %9.1f %8zu %8zu %9zu %7zu %8zu %9s %8s %9s %9.2f\n", r.label.c_str(), trajectory_length(r.means),
-                r.in_state, r.mapped, r.corrected, r.gated, r.unusable, number_or_dash(r.rmse, "%.2f").c_str(),
+                r.in_state, r.updates.initialized, r.updates.corrected, r.updates.rejected, r.updates.unusable, number_or_dash(r.rmse, "%.2f").c_str(),
                 number_or_dash(dead_reckoning_rmse / r.rmse, "%.2fx").c_str(), number_or_dash(r.anees, "%.2f").c_str(),
                 1e3 * r.seconds / static_cast<double>(d.frames.size()));
   }
@@ -284,10 +263,9 @@ void write_outputs(const RunOptions& options, const ViData& d, const std::vector
   if (options.plots) run_plot_script("plot_vislam.py", dir);
 }
 
-}  // namespace
-
-std::vector<TableRow> run_vislam(const RunOptions& options, const std::string& dataset,
-                                 const std::vector<BackendKind>& kinds, const RunnerConfig& config) {
+/// Visual-inertial SLAM on "stereo-vi" (the simulator) or a KITTI-derived .npz file.
+std::vector<TableRow> run_vislam(const CliOptions& cli, const std::string& dataset, const std::vector<BackendKind>& kinds,
+                                 const RunnerConfig& config) {
   const ViData d = dataset == "stereo-vi" ? simulated(config) : from_npz(dataset, config);
   std::printf("\n== %s: visual-inertial SLAM on SE(3) (seed 004), %zu frames, pool of %zu landmarks (%zu new per "
               "frame), pixel sigma %.2f px, smallest disparity for a new landmark %.1f px\n",
@@ -298,8 +276,12 @@ std::vector<TableRow> run_vislam(const RunOptions& options, const std::string& d
   print_table(d, runs);
   std::vector<TableRow> rows;
   for (const auto& r : runs) rows.push_back(table_row(d, r));
-  write_outputs(options, d, runs, config);
+  write_outputs(cli.output, d, runs, config);
   return rows;
 }
 
+const RegisterDatasetRun simulated_registration{"stereo-vi", run_vislam};
+const RegisterDatasetRun npz_registration{"npz", run_vislam};
+
+}  // namespace
 }  // namespace sextant::runner

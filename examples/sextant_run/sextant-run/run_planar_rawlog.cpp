@@ -1,10 +1,12 @@
 // sextant-run's rawlog part: reading a rawlog with its ground truth, and every chosen back-end on a
 // planar one (the spatial ones: run_spatial_rawlog.cpp).
 #include <filesystem>
+#include <sextant/mrpt/rawlog.hpp>
 #include <variant>
 
+#include "dataset_registry.hpp"
 #include "dataset_runner.hpp"
-#include "rawlog_runs.hpp"
+#include "landmark_dataset_runs.hpp"
 
 namespace sextant::runner {
 namespace {
@@ -20,22 +22,24 @@ mrpt_io::GroundTruthFiles require_ground_truth(const std::string& path) {
 
 }  // namespace
 
-std::vector<TableRow> run_rawlog(const RunOptions& options, const std::string& path, const std::vector<BackendKind>& kinds,
+std::vector<TableRow> run_rawlog(const CliOptions& cli, const std::string& path, const std::vector<BackendKind>& kinds,
                                  const RunnerConfig& config) {
   const std::string name = std::filesystem::path(path).filename().string();
   auto dataset = mrpt_io::read_rawlog(path, config.rawlog);
   return std::visit(
       [&](auto& data) {
         mrpt_io::attach_ground_truth(data, require_ground_truth(path));
-        return run_rawlog_dataset(options, name, data, kinds, config);
+        return run_landmark_dataset(cli.output, name, data, kinds, config);
       },
       dataset);
 }
 
-std::vector<TableRow> run_rawlog_dataset(const RunOptions& options, const std::string& name,
-                                         const mrpt_io::RawlogDataset2D& data, const std::vector<BackendKind>& kinds,
-                                         const RunnerConfig& config) {
-  return run_dataset(options, name, data, kinds, config, Scoring{2, 3, 2}, "m");
+const RegisterDatasetRun rawlog_registration{"rawlog", run_rawlog};
+
+std::vector<TableRow> run_landmark_dataset(const RunOptions& options, const std::string& name,
+                                           const io::LandmarkDataset<Se2Odometry, RangeBearing2D>& data,
+                                           const std::vector<BackendKind>& kinds, const RunnerConfig& config) {
+  return run_dataset(options, name, data, kinds, config, "m");
 }
 
 }  // namespace sextant::runner

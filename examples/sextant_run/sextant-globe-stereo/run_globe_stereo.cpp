@@ -11,7 +11,7 @@
 #include <sextant/io/csv_writer.hpp>
 #include <sextant/io/tum_writer.hpp>
 #include <sextant/sim/globe_render.hpp>
-#include <sextant/vision/globe_association_truth.hpp>
+#include <sextant/eval/globe_association_truth.hpp>
 #include <sextant/vision/gray_image_view.hpp>
 #include <sextant/vision/stereo_sequence.hpp>
 #include <sextant/vision/stereo_tracker.hpp>
@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "globe_runs.hpp"
-#include "globe_stereo_runs.hpp"
+#include "dataset_registry.hpp"
 #include "progress_bar.hpp"
 #include "runner_config.hpp"
 #include "table.hpp"
@@ -50,7 +50,7 @@ struct FrontEndTotals {
   }
 };
 
-void print_front_end(const FrontEndTotals& t, const vision::GlobeAssociationTruth* truth) {
+void print_front_end(const FrontEndTotals& t, const eval::GlobeAssociationTruth* truth) {
   const double n = static_cast<double>(std::max<std::size_t>(t.frames, 1));
   std::printf("front-end over %zu frames: %.0f left keypoints, %.0f stereo matches, %.1f observations per frame "
               "(%.1f associated, %.1f proposed as new)",
@@ -147,10 +147,13 @@ vision::StereoCalibration calibration_of(const sim::GlobeCameraOptions& o, const
   return c;
 }
 
-}  // namespace
-
-std::vector<TableRow> run_globe_stereo(const RunOptions& options, const std::string& save_images,
-                                       const std::vector<BackendKind>& kinds, const RunnerConfig& config) {
+/// The globe rendered as stereo images, the front-end, then every back-end on its observations and,
+/// for comparison, the EKF on the point simulator's observations of the same trajectory; with
+/// --save-images the rendered sequence is also written there (stereo:<dir> layout).
+std::vector<TableRow> run_globe_stereo(const CliOptions& cli, const std::string&, const std::vector<BackendKind>& kinds,
+                                       const RunnerConfig& config) {
+  const RunOptions& options = cli.output;
+  const std::string& save_images = cli.save_images;
   const auto o = globe_options(config.globe);
   const auto points = sim::simulate_globe_camera(o);
   std::printf("\n== globe-stereo: the globe of --dataset globe rendered as %dx%d stereo pairs (seed %llu), %d frames "
@@ -161,7 +164,7 @@ std::vector<TableRow> run_globe_stereo(const RunOptions& options, const std::str
   if (!save_images.empty()) vision::write_calibration(save_images, calibration);
   Tracker tracker(points.motion, points.sensor, points.prior, calibration.rig(), o.image_width, o.image_height,
                   tracker_options(config));
-  vision::GlobeAssociationTruth truth(o);
+  eval::GlobeAssociationTruth truth(o);
   FrontEndTotals totals;
   sim::GlobeCameraDataset stereo = points;
   std::vector<Observations> frames;
@@ -205,7 +208,11 @@ std::vector<TableRow> run_globe_stereo(const RunOptions& options, const std::str
   return rows;
 }
 
-std::vector<TableRow> run_stereo_directory(const RunOptions& options, const std::string& dir, const RunnerConfig& config) {
+/// A user's rectified sequence (left/*.png, right/*.png, calib.yaml): the front-end with EKF tracking.
+std::vector<TableRow> run_stereo_directory(const CliOptions& cli, const std::string& dataset,
+                                           const std::vector<BackendKind>&, const RunnerConfig& config) {
+  const RunOptions& options = cli.output;
+  const std::string dir = dataset.substr(std::string("stereo:").size());
   const vision::StereoSequence sequence(dir);
   const auto& c = sequence.calibration();
   PointInCamera3D sensor;
@@ -242,4 +249,8 @@ std::vector<TableRow> run_stereo_directory(const RunOptions& options, const std:
   return {};
 }
 
+const RegisterDatasetRun rendered_registration{"globe-stereo", run_globe_stereo};
+const RegisterDatasetRun directory_registration{"stereo", run_stereo_directory};
+
+}  // namespace
 }  // namespace sextant::runner

@@ -4,18 +4,24 @@
 #include <filesystem>
 #include <sextant/io/isam_dataset.hpp>
 
+#include "dataset_registry.hpp"
 #include "dataset_runner.hpp"
 
 namespace sextant::runner {
 
-std::vector<TableRow> run_isam(const RunOptions& options, const std::string& path, const std::vector<BackendKind>& kinds,
+namespace {
+
+std::vector<TableRow> run_isam(const CliOptions& cli, const std::string& path, const std::vector<BackendKind>& kinds,
                                const RunnerConfig& config) {
   const auto data = io::read_isam_dataset(path);
   std::size_t sightings = 0;
   for (const auto& step : data.steps) sightings += step.observations.size();
   std::printf("\n%s: %zu steps, %zu landmark sightings%s\n", path.c_str(), data.steps.size(), sightings,
               data.has_ground_truth() ? "" : "; no ground truth beside it: the runs are timed and written out, not scored");
-  return run_dataset(options, std::filesystem::path(path).filename().string(), data, kinds, config, Scoring{2, 3, 2}, "m");
+  return run_dataset(cli.output, std::filesystem::path(path).filename().string(), data, kinds, config, "m");
 }
 
+const RegisterDatasetRun registration{"isam", run_isam};
+
+}  // namespace
 }  // namespace sextant::runner

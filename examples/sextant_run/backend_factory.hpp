@@ -1,0 +1,76 @@
+#pragma once
+// The runner's one back-end factory: a BackendChoice (which algorithm, its name in the table and the
+// files, its options) and with_backend, which builds the back-end it names over a data set's models
+// and hands it to the caller. Every data-set family goes through it (experiments.hpp, run_globe.cpp,
+// run_vislam.cpp); a family that runs a back-end twice (SEIF per active-set size, the EKF with and
+// without first-estimate Jacobians) lists two choices.
+#include <sextant/models/se2_world_frame.hpp>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "runner_config.hpp"
+#include "table.hpp"
+
+namespace sextant::runner {
+
+/// One back-end configuration of a run.
+struct BackendChoice {
+  BackendKind kind;
+  std::string key;    ///< its name in the files (ekf, seif150, ...)
+  std::string label;  ///< its name in the table
+  EkfOptions ekf;
+  SeifOptions seif;
+  GraphOptions graph;
+  FastSlamOptions fastslam;
+};
+
+/// Whether a filter linearizes at first estimates (RunnerConfig::ekf_first_estimates, seif_first_estimates):
+/// `automatic` means on for the planar world-frame chart (Se2WorldSpace), where the textbook EKF is
+/// inconsistent (docs/design_notes.md), and off elsewhere.
+template <class Motion>
+bool use_first_estimates(FirstEstimates choice) {
+  if (choice == FirstEstimates::automatic) return std::is_same_v<typename Motion::Space, Se2WorldSpace>;
+  return choice == FirstEstimates::on;
+}
+
+/// One choice per kind, as the config sets it: the first-estimate policy for Motion's chart and
+/// FastSLAM's version from the kind.
+template <class Motion>
+std::vector<BackendChoice> backend_choices(const std::vector<BackendKind>& kinds, const RunnerConfig& c) {
+  std::vector<BackendChoice> choices;
+  for (BackendKind kind : kinds) {
+    BackendChoice choice{kind, backend_key(kind), backend_label(kind, c), c.ekf, c.seif, c.graph, c.fastslam};
+    choice.ekf.first_estimate_jacobians = use_first_estimates<Motion>(c.ekf_first_estimates);
+    choice.seif.first_estimate_jacobians = use_first_estimates<Motion>(c.seif_first_estimates);
+    choice.fastslam.version = kind == BackendKind::fastslam1 ? FastSlamVersion::v1 : FastSlamVersion::v2;
+    choices.push_back(std::move(choice));
+  }
+  return choices;
+}
+
+/// Builds the back-end `choice` names over the models and the prior and calls use(backend).
+template <class Motion, class Sensor, class Prior, class Use>
+void with_backend(const BackendChoice& choice, const Motion& motion, const Sensor& sensor, const Prior& prior, Use&& use) {
+  switch (choice.kind) {
+    case BackendKind::ekf: {
+      EkfSlam<Motion, Sensor> backend(motion, sensor, prior, choice.ekf);
+      return use(backend);
+    }
+    case BackendKind::seif: {
+      SeifSlam<Motion, Sensor> backend(motion, sensor, prior, choice.seif);
+      return use(backend);
+    }
+    case BackendKind::graph: {
+      GraphSlam<Motion, Sensor> backend(motion, sensor, prior, choice.graph);
+      return use(backend);
+    }
+    case BackendKind::fastslam1:
+    case BackendKind::fastslam2: {
+      FastSlam<Motion, Sensor> backend(motion, sensor, prior, choice.fastslam);
+      return use(backend);
+    }
+  }
+}
+
+}  // namespace sextant::runner
