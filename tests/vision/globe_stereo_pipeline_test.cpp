@@ -13,7 +13,7 @@
 
 #include "sextant/core/landmark_pool_policy.hpp"
 #include "sextant/sim/globe_render.hpp"
-#include "sextant/vision/globe_association_truth.hpp"
+#include "sextant/eval/globe_association_truth.hpp"
 #include "sextant/vision/gray_image_view.hpp"
 #include "sextant/vision/stereo_sequence.hpp"
 #include "sextant/vision/stereo_tracker.hpp"
@@ -54,7 +54,7 @@ TEST(GlobeStereoPipeline, AssociationsAreRightAgainstTheRenderingAndTheEkfTracks
   o.num_steps = 60;
   const auto data = sim::simulate_globe_camera(o);
   Tracker tracker(data.motion, data.sensor, data.prior, rig_of(o), o.image_width, o.image_height);
-  GlobeAssociationTruth truth(o);
+  eval::GlobeAssociationTruth truth(o);
   double position_error = 0.0;
   std::size_t later_observations = 0, later_new = 0;
   for (int k = 0; k < o.num_steps; ++k) {

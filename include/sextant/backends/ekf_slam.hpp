@@ -7,6 +7,9 @@
 #include <utility>
 #include <vector>
 
+#include "sextant/core/backend_types.hpp"
+#include "sextant/core/landmark_store.hpp"
+#include "sextant/core/rollback_guard.hpp"
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/first_estimates.hpp"
 #include "sextant/core/gaussian.hpp"
@@ -58,17 +61,7 @@ class EkfSlam {
   static_assert(ModelsFit<Motion, Sensor>::value, "EkfSlam: the models do not fit (see the message above)");
 
  public:
-  using State = typename Motion::State;
-  using Control = typename Motion::Control;
-  using Space = typename Motion::Space;
-  using Landmark = typename Sensor::Landmark;
-  using Measurement = typename Sensor::Measurement;
-  using ObservationType = Observation<Measurement>;
-  static constexpr int X = Motion::kDim;
-  static constexpr int M = landmark_dim_v<Sensor>;
-  static constexpr int Z = measurement_dim_v<Sensor>;
-  using PoseEstimate = Gaussian<State, X>;
-  using MapEstimate = std::vector<LandmarkEstimate<M>>;
+  SEXTANT_BACKEND_TYPES;
 
   EkfSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, EkfOptions options = {});
 
@@ -87,19 +80,19 @@ class EkfSlam {
   void remove_landmark(LandmarkId id);
 
   PoseEstimate pose() const { return {x_, symmetric_diagonal_block<X>(cov_.view(), 0)}; }
-  LandmarkEstimate<M> landmark(LandmarkId id) const { return landmark_at(pool_.slot(id)); }
+  LandmarkEstimate<M> landmark(LandmarkId id) const { return landmark_at(landmarks_.slot(id)); }
   MapEstimate map() const;
   /// The joint Gaussian of the robot and the landmarks `ids`, in that order (for data association,
   /// core/data_association.hpp): a gather from P, O((X + M k)^2). Throws unknown_landmark_error.
   JointMarginal<State, M> joint_marginal(std::span<const LandmarkId> ids) const;
-  bool has_landmark(LandmarkId id) const { return pool_.contains(id); }
-  std::size_t num_landmarks() const { return pool_.size(); }
+  bool has_landmark(LandmarkId id) const { return landmarks_.contains(id); }
+  std::size_t num_landmarks() const { return landmarks_.size(); }
   /// Joint covariance of (robot, landmarks in slot order), dimension X + M * num_landmarks().
   /// A copy: O(n^2).
   Eigen::MatrixXd covariance() const { return cov_.view().template selfadjointView<Eigen::Lower>(); }
   /// Dimension of the joint state, X + M * num_landmarks().
   Eigen::Index state_dim() const { return cov_.dim(); }
-  const std::vector<LandmarkId>& landmark_ids() const { return pool_.ids(); }
+  const std::vector<LandmarkId>& landmark_ids() const { return landmarks_.ids(); }
   const EkfOptions& options() const { return options_; }
 
  private:
@@ -114,9 +107,9 @@ class EkfSlam {
     Eigen::MatrixXd P_joseph;  ///< Joseph form: the whole corrected P
   };
 
-  static Eigen::Index offset_of(std::size_t slot) { return X + M * static_cast<Eigen::Index>(slot); }
+  static Eigen::Index offset_of(std::size_t slot) { return LandmarkStore<M>::template offset_of<X>(slot); }
   LandmarkEstimate<M> landmark_at(std::size_t slot) const;
-  Landmark landmark_mean(std::size_t slot) const { return landmark_means_.template segment<M>(M * slot); }
+  Landmark landmark_mean(std::size_t slot) const { return landmarks_.mean(slot); }
 
   /// Everything one update will change, computed without touching the state.
   struct Plan {
@@ -146,10 +139,8 @@ class EkfSlam {
   EkfOptions options_;
   InnovationGate gate_;
   State x_;
-  Eigen::VectorXd landmark_means_;
-  FirstLandmarkMeans<M> first_means_;  ///< each landmark's mean when it was added (first_estimate_jacobians)
-  GrowableSquareMatrix cov_;  ///< P; only its lower triangle is kept up to date
-  LandmarkPool pool_;
+  LandmarkStore<M> landmarks_;  ///< ids, slots, means and first means (first_estimate_jacobians)
+  GrowableSquareMatrix cov_;     ///< P; only its lower triangle is kept up to date
 };
 
 }  // namespace sextant

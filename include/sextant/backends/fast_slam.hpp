@@ -10,6 +10,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "sextant/core/backend_types.hpp"
+#include "sextant/core/landmark_pool.hpp"
 #include "sextant/core/chi_square.hpp"
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/gaussian.hpp"
@@ -73,17 +75,7 @@ class FastSlam {
   static_assert(ModelsFit<Motion, Sensor>::value, "FastSlam: the models do not fit (see the message above)");
 
  public:
-  using State = typename Motion::State;
-  using Control = typename Motion::Control;
-  using Space = typename Motion::Space;
-  using Landmark = typename Sensor::Landmark;
-  using Measurement = typename Sensor::Measurement;
-  using ObservationType = Observation<Measurement>;
-  static constexpr int X = Motion::kDim;
-  static constexpr int M = landmark_dim_v<Sensor>;
-  static constexpr int Z = measurement_dim_v<Sensor>;
-  using PoseEstimate = Gaussian<State, X>;
-  using MapEstimate = std::vector<LandmarkEstimate<M>>;
+  SEXTANT_BACKEND_TYPES;
 
   struct Particle {
     State x;
@@ -145,23 +137,40 @@ class FastSlam {
 
   static State sample(const State& mean, const Eigen::Matrix<double, X, X>& cov, std::mt19937_64& rng);
   void apply_pending_motion_v1(Transaction& t) const;
-  /// What one landmark update adds to the particle's log weight, and whether the gate rejected it.
   /// What became of one observation in one particle.
-  enum Outcome : char { used = 0, gated = 1, unusable = 2 };
+  enum class Outcome : char { used, gated, unusable };
+  /// What one landmark update adds to the particle's log weight, and what became of the observation.
   struct LandmarkUpdate {
     double log_likelihood;
     Outcome outcome;
   };
-  auto predict_if_observable(const State& x, const Landmark& m) const
-      -> std::optional<decltype(std::declval<const Sensor&>().predict(x, m))>;
+  using PoseMatrix = Eigen::Matrix<double, X, X>;
+  static constexpr std::size_t kNewLandmark = ~std::size_t{0};  ///< association: no landmark, start one
+  using Prediction = decltype(std::declval<const Sensor&>().predict(std::declval<const State&>(), std::declval<const Landmark&>()));
+  /// A measurement of a landmark against the Gaussian proposal of the pose (FastSLAM 2.0).
+  struct ProposalInnovation {
+    Prediction prediction;
+    Eigen::Matrix<double, Z, 1> nu;
+    Eigen::LLT<Eigen::Matrix<double, Z, Z>> llt;  ///< of S = H_x Sigma H_x^T + H_m Sigma_m H_m^T + Q
+  };
+  auto predict_if_observable(const State& x, const Landmark& m) const -> std::optional<Prediction>;
   std::vector<ObservationType> add_new_landmarks(std::vector<Particle>& particles, std::span<const ObservationType> fresh,
                                                  std::vector<LandmarkId>& unusable) const;
   LandmarkUpdate update_landmark(Particle& particle, std::size_t index, const Measurement& z, bool unassociated,
                                  bool gated) const;
   template <class Llt>
   double log_likelihood_at_gate_edge(const Llt& llt) const;
-  std::vector<char> sample_v2_proposal(Particle& particle, const State& predicted, const Eigen::Matrix<double, X, X>& R,
-                                       std::span<const ObservationType> known, std::mt19937_64& rng) const;
+  ProposalInnovation proposal_innovation(Prediction prediction, const PoseMatrix& cov, const LandmarkGaussian<M>& landmark,
+                                         const Measurement& z) const;
+  static double fold_into_proposal(State& mean, PoseMatrix& cov, const ProposalInnovation& innovation);
+  std::vector<Outcome> sample_v2_proposal(Particle& particle, const State& predicted, const PoseMatrix& R,
+                                          std::span<const ObservationType> known, std::mt19937_64& rng) const;
+  std::vector<Outcome> update_known_landmarks(Particle& particle, std::span<const ObservationType> known,
+                                              bool proposal, Transaction& t) const;
+  std::size_t update_particle_unassociated(Particle& particle, std::span<const Measurement> measurements, bool proposal,
+                                           Transaction& t) const;
+  std::vector<std::size_t> associate_in_particle(Particle& particle, State& mean, PoseMatrix& cov,
+                                                 std::span<const Measurement> measurements, bool proposal) const;
   void normalize_and_resample(Transaction& t) const;
   PoseEstimate cloud_estimate(const std::vector<Particle>& cloud, const std::vector<PendingMotion>& pending) const;
   static std::vector<double> normalized_weights(const std::vector<Particle>& particles);

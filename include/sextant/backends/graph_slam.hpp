@@ -11,6 +11,9 @@
 #include <utility>
 #include <vector>
 
+#include "sextant/core/backend_types.hpp"
+#include "sextant/core/landmark_store.hpp"
+#include "sextant/core/rollback_guard.hpp"
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/landmark_pool.hpp"
@@ -77,17 +80,7 @@ class GraphSlam {
   static_assert(ModelsFit<Motion, Sensor>::value, "GraphSlam: the models do not fit (see the message above)");
 
  public:
-  using State = typename Motion::State;
-  using Control = typename Motion::Control;
-  using Space = typename Motion::Space;
-  using Landmark = typename Sensor::Landmark;
-  using Measurement = typename Sensor::Measurement;
-  using ObservationType = Observation<Measurement>;
-  static constexpr int X = Motion::kDim;
-  static constexpr int M = landmark_dim_v<Sensor>;
-  static constexpr int Z = measurement_dim_v<Sensor>;
-  using PoseEstimate = Gaussian<State, X>;
-  using MapEstimate = std::vector<LandmarkEstimate<M>>;
+  SEXTANT_BACKEND_TYPES;
 
   GraphSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, GraphOptions options = {});
 
@@ -120,13 +113,13 @@ class GraphSlam {
   /// (which costs much more when landmarks are seen from many poses, as in visual SLAM).
   std::vector<std::pair<LandmarkId, Landmark>> landmark_means() const {
     std::vector<std::pair<LandmarkId, Landmark>> out;
-    for (std::size_t slot = 0; slot < pool_.size(); ++slot) out.emplace_back(pool_.id_at(slot), landmark_mean(slot));
+    for (std::size_t slot = 0; slot < landmarks_.size(); ++slot) out.emplace_back(landmarks_.id_at(slot), landmark_mean(slot));
     return out;
   }
-  bool has_landmark(LandmarkId id) const { return pool_.contains(id); }
-  std::size_t num_landmarks() const { return pool_.size(); }
+  bool has_landmark(LandmarkId id) const { return landmarks_.contains(id); }
+  std::size_t num_landmarks() const { return landmarks_.size(); }
   std::size_t num_poses() const { return poses_.size(); }
-  const std::vector<LandmarkId>& landmark_ids() const { return pool_.ids(); }
+  const std::vector<LandmarkId>& landmark_ids() const { return landmarks_.ids(); }
   const std::vector<State>& pose_means() const { return poses_; }
   /// chi2 of all factors at the current estimate.
   double cost() const;
@@ -159,6 +152,10 @@ class GraphSlam {
   static void require_factorizable_extension(const Eigen::Matrix<double, X, X>& P, const Eigen::Matrix<double, D, X>& J,
                                              const Eigen::Matrix<double, D, D>& C, const std::string& what);
   Linearization linearize(std::size_t pose_count) const;
+  void add_prior_factor(Linearization& sys) const;
+  void add_motion_factors(Linearization& sys) const;
+  void add_marginal_factors(Linearization& sys) const;
+  void add_measurement_factors(Linearization& sys) const;
   auto predict_if_observable(const State& x, const Landmark& m) const
       -> std::optional<decltype(std::declval<const Sensor&>().predict(x, m))>;
   Eigen::VectorXd solve_by_landmark_schur(const Linearization& system, OptimizationSummary& summary) const;
@@ -171,7 +168,7 @@ class GraphSlam {
   std::shared_ptr<const SelectedInverse> marginals() const;
   bool uses_landmark_schur(const Linearization& system) const;
   Eigen::Matrix<double, X, X> newest_pose_marginal(const Linearization& system);
-  Landmark landmark_mean(std::size_t slot) const { return landmark_means_.template segment<M>(M * slot); }
+  Landmark landmark_mean(std::size_t slot) const { return landmarks_.mean(slot); }
   void touch() { ++revision_; }
 
   Motion motion_;
@@ -183,8 +180,7 @@ class GraphSlam {
   std::vector<MotionRecord> motions_;                          ///< motions_[k]: pose k -> k + 1
   std::vector<std::vector<MeasurementRecord>> measurements_;   ///< per landmark slot
   std::vector<LinearFactor> linear_factors_;
-  Eigen::VectorXd landmark_means_;
-  LandmarkPool pool_;
+  LandmarkStore<M> landmarks_;
   bool windows_done_ = false;
   std::uint64_t revision_ = 0;
   Eigen::Matrix<double, X, X> newest_cov_;  ///< see pose()

@@ -12,6 +12,8 @@
 #include <span>
 #include <vector>
 
+#include "sextant/core/backend_types.hpp"
+#include "sextant/core/landmark_store.hpp"
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/first_estimates.hpp"
 #include "sextant/core/gaussian.hpp"
@@ -75,17 +77,7 @@ class SeifSlam {
   static_assert(ModelsFit<Motion, Sensor>::value, "SeifSlam: the models do not fit (see the message above)");
 
  public:
-  using State = typename Motion::State;
-  using Control = typename Motion::Control;
-  using Space = typename Motion::Space;
-  using Landmark = typename Sensor::Landmark;
-  using Measurement = typename Sensor::Measurement;
-  using ObservationType = Observation<Measurement>;
-  static constexpr int X = Motion::kDim;
-  static constexpr int M = landmark_dim_v<Sensor>;
-  static constexpr int Z = measurement_dim_v<Sensor>;
-  using PoseEstimate = Gaussian<State, X>;
-  using MapEstimate = std::vector<LandmarkEstimate<M>>;
+  SEXTANT_BACKEND_TYPES;
 
   SeifSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, SeifOptions options = {});
 
@@ -116,9 +108,9 @@ class SeifSlam {
   /// core/data_association.hpp): one multi-column solve with the factor of Omega, X + M k columns.
   /// Throws unknown_landmark_error.
   JointMarginal<State, M> joint_marginal(std::span<const LandmarkId> ids) const;
-  bool has_landmark(LandmarkId id) const { return pool_.contains(id); }
-  std::size_t num_landmarks() const { return pool_.size(); }
-  const std::vector<LandmarkId>& landmark_ids() const { return pool_.ids(); }
+  bool has_landmark(LandmarkId id) const { return landmarks_.contains(id); }
+  std::size_t num_landmarks() const { return landmarks_.size(); }
+  const std::vector<LandmarkId>& landmark_ids() const { return landmarks_.ids(); }
   Eigen::Index state_dim() const { return info_.dim(); }
   /// Ids of the landmarks linked to the robot, most recently observed first.
   std::vector<LandmarkId> active_landmarks() const;
@@ -151,8 +143,8 @@ class SeifSlam {
     Eigen::Matrix<double, M, M> mm;  ///< W
   };
 
-  static Eigen::Index offset_of(std::size_t slot) { return X + M * static_cast<Eigen::Index>(slot); }
-  Landmark landmark_mean(std::size_t slot) const { return landmark_means_.template segment<M>(M * slot); }
+  static Eigen::Index offset_of(std::size_t slot) { return LandmarkStore<M>::template offset_of<X>(slot); }
+  Landmark landmark_mean(std::size_t slot) const { return landmarks_.mean(slot); }
 
   /// Nothing when the model cannot use the observation here (its id then goes to `unusable`).
   std::optional<Linearized> linearize(const ObservationType& observation, std::vector<LandmarkId>& unusable) const;
@@ -193,10 +185,8 @@ class SeifSlam {
   SeifOptions options_;
   InnovationGate gate_;
   State x_;
-  Eigen::VectorXd landmark_means_;
-  FirstLandmarkMeans<M> first_means_;  ///< each landmark's mean when it was added (first_estimate_jacobians)
   SparseInformation<X, M> info_;
-  LandmarkPool pool_;
+  LandmarkStore<M> landmarks_;  ///< ids, slots, means and first means (first_estimate_jacobians)
   SeifUpdateTimes last_update_times_;
   std::vector<std::size_t> active_queue_;  ///< slots linked to the robot, most recently observed first
   std::uint64_t updates_ = 0;

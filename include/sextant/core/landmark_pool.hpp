@@ -57,7 +57,7 @@ class LandmarkPool {
   std::vector<LandmarkId> ids_;
 };
 
-/// Observations split into those of landmarks the pool holds and those of new landmarks, each in
+/// Observations split into those of landmarks the map holds and those of new landmarks, each in
 /// the order given.
 template <class Measurement>
 struct SplitObservations {
@@ -65,12 +65,12 @@ struct SplitObservations {
   std::vector<Observation<Measurement>> fresh;
 };
 
-template <class Measurement>
-SplitObservations<Measurement> split_known_and_new(const LandmarkPool& pool,
-                                                   std::span<const Observation<Measurement>> observations) {
+/// `map` is anything with contains(id): a LandmarkPool, or FastSLAM's id -> index map.
+template <class Map, class Measurement>
+SplitObservations<Measurement> split_known_and_new(const Map& map, std::span<const Observation<Measurement>> observations) {
   SplitObservations<Measurement> out;
   for (const auto& observation : observations)
-    (pool.contains(observation.landmark_id) ? out.known : out.fresh).push_back(observation);
+    (map.contains(observation.landmark_id) ? out.known : out.fresh).push_back(observation);
   return out;
 }
 

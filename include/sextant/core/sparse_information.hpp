@@ -16,6 +16,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "sextant/core/block_triplets.hpp"
 #include "sextant/core/error.hpp"
 
 namespace sextant {
@@ -279,24 +280,15 @@ void SparseInformation<X, M>::move_slot(std::size_t from, std::size_t to) {
 
 template <int X, int M>
 Eigen::SparseMatrix<double> SparseInformation<X, M>::to_sparse() const {
-  std::vector<Eigen::Triplet<double>> triplets;
-  auto add_block = [&](Eigen::Index row, Eigen::Index col, const auto& block) {
-    for (Eigen::Index c = 0; c < block.cols(); ++c)
-      for (Eigen::Index r = 0; r < block.rows(); ++r) triplets.emplace_back(row + r, col + c, block(r, c));
-  };
+  BlockTriplets triplets;
   auto offset = [](std::size_t slot) { return X + M * static_cast<Eigen::Index>(slot); };
-  add_block(0, 0, robot_);
-  for (const auto& [slot, block] : robot_links_) {
-    add_block(0, offset(slot), block);
-    add_block(offset(slot), 0, block.transpose());
-  }
+  triplets.add(0, 0, robot_);
+  for (const auto& [slot, block] : robot_links_) triplets.add_symmetric(0, offset(slot), block);
   for (std::size_t i = 0; i < num_landmarks(); ++i) {
-    add_block(offset(i), offset(i), diagonal_[i]);
-    for (const auto& [j, block] : links_[i]) add_block(offset(i), offset(j), block);
+    triplets.add(offset(i), offset(i), diagonal_[i]);
+    for (const auto& [j, block] : links_[i]) triplets.add(offset(i), offset(j), block);
   }
-  Eigen::SparseMatrix<double> out(dim(), dim());
-  out.setFromTriplets(triplets.begin(), triplets.end());
-  return out;
+  return triplets.to_sparse(dim(), dim());
 }
 
 template <int X, int M>

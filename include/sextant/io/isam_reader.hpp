@@ -10,6 +10,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <unordered_set>
@@ -63,6 +64,96 @@ Eigen::Matrix<double, N, N> noise_covariance(const std::vector<double>& values, 
   return llt.solve(Eigen::Matrix<double, N, N>::Identity());
 }
 
+/// One line of an iSAM file: its tag and values, and where it is for messages.
+struct IsamRecord {
+  std::string where, tag;
+  std::vector<double> values;
+
+  /// A value as an identifier; parse_error otherwise.
+  std::uint64_t identifier(std::size_t index, const char* what) const {
+    const auto id = as_identifier(values[index]);
+    if (!id)
+      throw parse_error(where + ": " + what + " must be a non-negative integer below 2^53, got " +
+                        std::to_string(values[index]));
+    return *id;
+  }
+  void require_fields(std::size_t count) const {
+    if (values.size() != count)
+      throw parse_error(where + ": " + tag + " needs " + std::to_string(count) + " values, found " +
+                        std::to_string(values.size()));
+  }
+};
+
+/// The record on `line`; nullopt for a blank line or a comment.
+inline std::optional<IsamRecord> parse_isam_record(const std::string& line, std::string where) {
+  std::istringstream fields(line);
+  IsamRecord record{std::move(where), {}, {}};
+  if (!(fields >> record.tag) || record.tag[0] == '#') return std::nullopt;
+  for (std::string word; fields >> word;) {
+    const auto value = parse_finite_number(word);
+    if (!value) throw parse_error(record.where + ": '" + word + "' is not a finite number");
+    record.values.push_back(*value);
+  }
+  return record;
+}
+
+/// Builds the data set record by record (read_isam_2d).
+class IsamDatasetBuilder {
+ public:
+  explicit IsamDatasetBuilder(IsamNoise form) : form_(form) {}
+
+  void add(const IsamRecord& record) {
+    if (record.tag == "EDGE2" || record.tag == "ODOMETRY") return add_odometry(record);
+    if (record.tag == "LANDMARK") return add_landmark(record);
+    throw parse_error(record.where + ": unknown record '" + record.tag + "'");
+  }
+  PlanarDataset& data() { return data_; }
+
+ private:
+  void add_odometry(const IsamRecord& record) {
+    record.require_fields(11);
+    const auto from = static_cast<long long>(record.identifier(0, "pose id")),
+               to = static_cast<long long>(record.identifier(1, "pose id"));
+    if (data_.pose_ids.empty()) data_.pose_ids.push_back(from);
+    if (from != data_.pose_ids.back())
+      throw parse_error(record.where + ": odometry from pose " + std::to_string(from) +
+                        " does not continue the chain (newest pose " + std::to_string(data_.pose_ids.back()) +
+                        "); loop-closure edges are not supported");
+    OdometryIncrement2D u;
+    u.delta << record.values[2], record.values[3], record.values[4];
+    u.cov = noise_covariance<3>({record.values.begin() + 5, record.values.end()}, form_, record.where);
+    data_.steps.push_back({u, 1.0, {}});
+    data_.pose_ids.push_back(to);
+    seen_from_current_pose_.clear();
+  }
+
+  void add_landmark(const IsamRecord& record) {
+    record.require_fields(7);
+    const auto pose = static_cast<long long>(record.identifier(0, "pose id"));
+    if (data_.pose_ids.empty()) data_.pose_ids.push_back(pose);
+    if (pose != data_.pose_ids.back())
+      throw parse_error(record.where + ": landmark seen from pose " + std::to_string(pose) + ", but the newest pose is " +
+                        std::to_string(data_.pose_ids.back()));
+    const Eigen::Matrix2d cov = noise_covariance<2>({record.values.begin() + 4, record.values.end()}, form_, record.where);
+    if (!have_landmark_noise_) {
+      data_.landmark_cov = cov;
+      have_landmark_noise_ = true;
+    } else if (!cov.isApprox(data_.landmark_cov, 1e-12)) {
+      throw parse_error(record.where + ": landmark noise differs from the first LANDMARK record (one measurement model, one Q)");
+    }
+    const LandmarkId id = record.identifier(1, "landmark id");
+    if (!seen_from_current_pose_.insert(id).second)
+      throw parse_error(record.where + ": landmark " + std::to_string(id) + " seen twice from pose " + std::to_string(pose));
+    Observation<Eigen::Vector2d> observation{id, Eigen::Vector2d(record.values[2], record.values[3])};
+    (data_.steps.empty() ? data_.initial_observations : data_.steps.back().observations).push_back(observation);
+  }
+
+  IsamNoise form_;
+  PlanarDataset data_;
+  bool have_landmark_noise_ = false;
+  std::unordered_set<LandmarkId> seen_from_current_pose_;
+};
+
 }  // namespace detail
 
 /// Reads the file; throws parse_error naming the file and line for anything it cannot use:
@@ -73,72 +164,12 @@ Eigen::Matrix<double, N, N> noise_covariance(const std::vector<double>& values, 
 inline PlanarDataset read_isam_2d(const std::string& path, IsamNoise form) {
   std::ifstream in(path);
   if (!in) throw parse_error(path + ": cannot open file");
-  PlanarDataset data;
-  bool have_landmark_noise = false;
-  std::unordered_set<LandmarkId> seen_from_current_pose;
+  detail::IsamDatasetBuilder builder(form);
   std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
-    const std::string where = path + ":" + std::to_string(number);
-    std::istringstream fields(line);
-    std::string tag;
-    if (!(fields >> tag) || tag[0] == '#') continue;
-    std::vector<std::string> words;
-    for (std::string word; fields >> word;) words.push_back(word);
-    std::vector<double> values;
-    for (const auto& word : words) {
-      const auto value = parse_finite_number(word);
-      if (!value) throw parse_error(where + ": '" + word + "' is not a finite number");
-      values.push_back(*value);
-    }
-    auto identifier = [&](double value, const char* what) {
-      const auto id = as_identifier(value);
-      if (!id) throw parse_error(where + ": " + what + " must be a non-negative integer below 2^53, got " + std::to_string(value));
-      return *id;
-    };
-    auto require_fields = [&](std::size_t count) {
-      if (values.size() != count)
-        throw parse_error(where + ": " + tag + " needs " + std::to_string(count) + " values, found " +
-                          std::to_string(values.size()));
-    };
-    if (tag == "EDGE2" || tag == "ODOMETRY") {
-      require_fields(11);
-      const auto from = static_cast<long long>(identifier(values[0], "pose id")),
-                 to = static_cast<long long>(identifier(values[1], "pose id"));
-      if (data.pose_ids.empty()) data.pose_ids.push_back(from);
-      if (from != data.pose_ids.back())
-        throw parse_error(where + ": odometry from pose " + std::to_string(from) + " does not continue the chain (newest pose " +
-                          std::to_string(data.pose_ids.back()) + "); loop-closure edges are not supported");
-      OdometryIncrement2D u;
-      u.delta << values[2], values[3], values[4];
-      u.cov = detail::noise_covariance<3>({values.begin() + 5, values.end()}, form, where);
-      data.steps.push_back({u, 1.0, {}});
-      data.pose_ids.push_back(to);
-      seen_from_current_pose.clear();
-    } else if (tag == "LANDMARK") {
-      require_fields(7);
-      const auto pose = static_cast<long long>(identifier(values[0], "pose id"));
-      if (data.pose_ids.empty()) data.pose_ids.push_back(pose);
-      if (pose != data.pose_ids.back())
-        throw parse_error(where + ": landmark seen from pose " + std::to_string(pose) + ", but the newest pose is " +
-                          std::to_string(data.pose_ids.back()));
-      const Eigen::Matrix2d cov = detail::noise_covariance<2>({values.begin() + 4, values.end()}, form, where);
-      if (!have_landmark_noise) {
-        data.landmark_cov = cov;
-        have_landmark_noise = true;
-      } else if (!cov.isApprox(data.landmark_cov, 1e-12)) {
-        throw parse_error(where + ": landmark noise differs from the first LANDMARK record (one measurement model, one Q)");
-      }
-      const LandmarkId id = identifier(values[1], "landmark id");
-      if (!seen_from_current_pose.insert(id).second)
-        throw parse_error(where + ": landmark " + std::to_string(id) + " seen twice from pose " + std::to_string(pose));
-      Observation<Eigen::Vector2d> observation{id, Eigen::Vector2d(values[2], values[3])};
-      (data.steps.empty() ? data.initial_observations : data.steps.back().observations).push_back(observation);
-    } else {
-      throw parse_error(where + ": unknown record '" + tag + "'");
-    }
-  }
-  if (data.pose_ids.empty()) throw parse_error(path + ": no odometry or landmark records");
-  return data;
+  for (int number = 1; std::getline(in, line); ++number)
+    if (const auto record = detail::parse_isam_record(line, path + ":" + std::to_string(number))) builder.add(*record);
+  if (builder.data().pose_ids.empty()) throw parse_error(path + ": no odometry or landmark records");
+  return std::move(builder.data());
 }
 
 /// Poses and landmarks of a noise-free data set (e.g. cityTrees10000_groundtruth.txt): poses by

@@ -13,18 +13,13 @@
 #include <random>
 #include <vector>
 
+#include "sextant/core/gray_image.hpp"
 #include "sextant/models/euler_camera_12d.hpp"
 #include "sextant/sim/globe_camera.hpp"
 
 namespace sextant::sim {
 
-/// An 8-bit grayscale image, row-major.
-struct GrayImage {
-  int width = 0, height = 0;
-  std::vector<std::uint8_t> pixels;
-
-  std::uint8_t at(int u, int v) const { return pixels[static_cast<std::size_t>(v) * width + u]; }
-};
+using sextant::GrayImage;  // core/gray_image.hpp
 
 struct StereoImages {
   GrayImage left, right;

@@ -43,27 +43,17 @@ void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
 template <class Motion, class Sensor>
 UpdateResult EkfSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
   require_valid_observations(observations);
-  const auto [known, fresh] = split_known_and_new(pool_, observations);
+  const auto [known, fresh] = split_known_and_new(landmarks_.pool(), observations);
   UpdateResult result;
   if (options_.batch_update || known.size() <= 1) {
     commit(plan(known, fresh, result));
     return result;
   }
-  const State x_before = x_;
-  const Eigen::VectorXd means_before = landmark_means_;
-  const FirstLandmarkMeans<M> first_before = first_means_;
-  const GrowableSquareMatrix cov_before = cov_;
-  try {
-    const std::span<const ObservationType> all_known(known);
-    for (std::size_t i = 0; i < known.size(); ++i) commit(plan(all_known.subspan(i, 1), {}, result));
-    commit(plan({}, fresh, result));
-  } catch (...) {
-    x_ = x_before;
-    landmark_means_ = means_before;
-    first_means_ = first_before;
-    cov_ = cov_before;
-    throw;
-  }
+  RollbackGuard guard(x_, landmarks_, cov_);
+  const std::span<const ObservationType> all_known(known);
+  for (std::size_t i = 0; i < known.size(); ++i) commit(plan(all_known.subspan(i, 1), {}, result));
+  commit(plan({}, fresh, result));
+  guard.commit();
   return result;
 }
 
@@ -73,12 +63,12 @@ auto EkfSlam<Motion, Sensor>::linearize(std::span<const ObservationType> known, 
   std::vector<Linearized> out;
   out.reserve(known.size());
   for (const auto& observation : known) {
-    const std::size_t slot = pool_.slot(observation.landmark_id);
+    const std::size_t slot = landmarks_.slot(observation.landmark_id);
     auto lin = linearize_if_observable(sensor_, x_, landmark_mean(slot), observation.z, observation.landmark_id,
                                        offset_of(slot), result.unusable);
     if (!lin) continue;
     if (options_.first_estimate_jacobians)
-      use_first_estimate_jacobians(sensor_, x_, Landmark(first_means_.at(slot)), observation.z, *lin);
+      use_first_estimate_jacobians(sensor_, x_, Landmark(landmarks_.first_mean(slot)), observation.z, *lin);
     out.push_back(std::move(*lin));
   }
   return out;
@@ -194,7 +184,7 @@ void EkfSlam<Motion, Sensor>::apply(const Correction& correction) {
   else
     P.template triangularView<Eigen::Lower>() = correction.P_joseph;
   x_ = correction.x;
-  landmark_means_ += correction.delta.tail(correction.delta.size() - X);
+  landmarks_.means().stacked() += correction.delta.tail(correction.delta.size() - X);
 }
 
 template <class Motion, class Sensor>
@@ -238,7 +228,7 @@ void EkfSlam<Motion, Sensor>::commit(const Plan& plan) {
 template <class Motion, class Sensor>
 void EkfSlam<Motion, Sensor>::augment(LandmarkId id, const Init& init) {
   const Eigen::Index offset = cov_.dim();
-  pool_.add(id);
+  landmarks_.add(id, init.m);
   cov_.grow(M);
   auto P = cov_.view();
   const Eigen::Matrix<double, X, X> P_xx = symmetric_diagonal_block<X>(P, 0);
@@ -246,46 +236,34 @@ void EkfSlam<Motion, Sensor>::augment(LandmarkId id, const Init& init) {
   P.block(offset, X, M, offset - X) = init.J_m_x * P.block(X, 0, offset - X, X).transpose();
   P.template block<M, M>(offset, offset) =
       symmetrized(init.J_m_x * P_xx * init.J_m_x.transpose() + init.J_m_z * init.Q * init.J_m_z.transpose());
-  landmark_means_.conservativeResize(landmark_means_.size() + M);
-  landmark_means_.template tail<M>() = init.m;
-  first_means_.append(init.m);
 }
 
 /// Marginalization in moment form: drop the landmark's rows and columns (thesis §4.2.2).
 template <class Motion, class Sensor>
 void EkfSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
-  const auto removal = pool_.remove(id);
+  const auto removal = landmarks_.remove(id);
   auto P = cov_.view();
   mirror_lower_to_upper(P);  // the move below reads whole rows and columns
   cov_.remove_block_by_moving_last(offset_of(removal.freed_slot), M);
-  landmark_means_.template segment<M>(M * removal.freed_slot) = landmark_means_.template segment<M>(M * removal.last_slot);
-  landmark_means_.conservativeResize(landmark_means_.size() - M);
-  first_means_.move_last_into(removal.freed_slot);
 }
 
 template <class Motion, class Sensor>
 auto EkfSlam<Motion, Sensor>::landmark_at(std::size_t slot) const -> LandmarkEstimate<M> {
-  return {pool_.id_at(slot), landmark_mean(slot), symmetric_diagonal_block<M>(cov_.view(), offset_of(slot))};
+  return {landmarks_.id_at(slot), landmark_mean(slot), symmetric_diagonal_block<M>(cov_.view(), offset_of(slot))};
 }
 
 template <class Motion, class Sensor>
 auto EkfSlam<Motion, Sensor>::map() const -> MapEstimate {
   MapEstimate out;
-  out.reserve(pool_.size());
-  for (std::size_t slot = 0; slot < pool_.size(); ++slot) out.push_back(landmark_at(slot));
+  out.reserve(landmarks_.size());
+  for (std::size_t slot = 0; slot < landmarks_.size(); ++slot) out.push_back(landmark_at(slot));
   return out;
 }
 
 template <class Motion, class Sensor>
 auto EkfSlam<Motion, Sensor>::joint_marginal(std::span<const LandmarkId> ids) const -> JointMarginal<State, M> {
   JointMarginal<State, M> out{x_, {ids.begin(), ids.end()}, {}, {}};
-  std::vector<Eigen::Index> offsets;
-  for (const LandmarkId id : ids) {
-    const std::size_t slot = pool_.slot(id);
-    out.landmarks.push_back(landmark_mean(slot));
-    offsets.push_back(offset_of(slot));
-  }
-  const auto rows = joint_rows<X, M>(offsets);
+  const auto rows = joint_rows<X, M>(landmarks_.template gather<X>(ids, out.landmarks));
   const auto lower = cov_.view();
   const Eigen::Index n = static_cast<Eigen::Index>(rows.size());
   out.cov.resize(n, n);

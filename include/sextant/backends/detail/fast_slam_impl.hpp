@@ -115,7 +115,7 @@ auto FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::siz
   auto& map = unassociated ? particle.unassociated : particle.landmarks;
   const LandmarkGaussian<M>& L = map[index];
   const auto prediction = predict_if_observable(particle.x, L.mean);
-  if (!prediction) return {0.0, unusable};
+  if (!prediction) return {0.0, Outcome::unusable};
   const auto& pred = *prediction;
   const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(z, pred.z);
   const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
@@ -129,7 +129,7 @@ auto FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::siz
   if (!updated.mean.allFinite() || !updated.cov.allFinite() || !std::isfinite(log_likelihood))
     throw numerical_error("landmark update is not finite");
   map.set(index, std::move(updated));
-  return {log_likelihood, used};
+  return {log_likelihood, Outcome::used};
 }
 
 /// The model's prediction, or nothing where it cannot predict (unobservable_error: in this
@@ -137,7 +137,7 @@ auto FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::siz
 /// nor weighs on it: a Gaussian likelihood is not defined there.
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::predict_if_observable(const State& x, const Landmark& m) const
-    -> std::optional<decltype(std::declval<const Sensor&>().predict(x, m))> {
+    -> std::optional<Prediction> {
   try {
     return sensor_.predict(x, m);
   } catch (const unobservable_error&) {
@@ -151,39 +151,74 @@ auto FastSlam<Motion, Sensor, Map>::predict_if_observable(const State& x, const 
 /// over the observations); the pose is then sampled from the result. An observation that fails the
 /// gate does not shape the proposal and weighs as on the gate's edge; the result flags it.
 template <class Motion, class Sensor, template <class> class Map>
-std::vector<char> FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const State& predicted,
-                                                       const Eigen::Matrix<double, X, X>& R,
+auto FastSlam<Motion, Sensor, Map>::proposal_innovation(Prediction prediction, const PoseMatrix& cov,
+                                                        const LandmarkGaussian<M>& landmark, const Measurement& z) const
+    -> ProposalInnovation {
+  const Eigen::Matrix<double, Z, Z> S = symmetrized(prediction.J_z_x * cov * prediction.J_z_x.transpose() +
+                                                    prediction.J_z_m * landmark.cov * prediction.J_z_m.transpose() +
+                                                    prediction.Q);
+  Eigen::Matrix<double, Z, 1> nu = sensor_.residual(z, prediction.z);
+  return {std::move(prediction), std::move(nu), cholesky_or_throw(S, "proposal innovation covariance")};
+}
+
+/// One measurement folded into the Gaussian proposal of the pose (thesis eqs. 91-92): K = Sigma H_x^T S^-1,
+/// mu = mu (+) K nu, Sigma = (I - K H_x) Sigma. Returns log N(nu; 0, S), its factor of the weight (eq. 93).
+template <class Motion, class Sensor, template <class> class Map>
+double FastSlam<Motion, Sensor, Map>::fold_into_proposal(State& mean, PoseMatrix& cov, const ProposalInnovation& in) {
+  const Eigen::Matrix<double, X, Z> K = in.llt.solve(in.prediction.J_z_x * cov).transpose();
+  mean = Space::plus(mean, K * in.nu);
+  cov = symmetrized((PoseMatrix::Identity() - K * in.prediction.J_z_x) * cov);
+  return detail::log_gaussian(in.llt, in.nu);
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const State& predicted, const PoseMatrix& R,
                                                        std::span<const ObservationType> known,
-                                                       std::mt19937_64& rng) const {
+                                                       std::mt19937_64& rng) const -> std::vector<Outcome> {
   State mean = predicted;
-  Eigen::Matrix<double, X, X> cov = R;
-  std::vector<char> rejected(known.size(), 0);
+  PoseMatrix cov = R;
+  std::vector<Outcome> outcomes(known.size(), Outcome::used);
   for (std::size_t i = 0; i < known.size(); ++i) {
-    const auto& observation = known[i];
-    const LandmarkGaussian<M>& L = particle.landmarks[index_.at(observation.landmark_id)];
-    const auto prediction = predict_if_observable(mean, L.mean);
+    const LandmarkGaussian<M>& L = particle.landmarks[index_.at(known[i].landmark_id)];
+    auto prediction = predict_if_observable(mean, L.mean);
     if (!prediction) {
-      rejected[i] = unusable;
+      outcomes[i] = Outcome::unusable;
       continue;
     }
-    const auto& pred = *prediction;
-    const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(observation.z, pred.z);
-    const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_x * cov * pred.J_z_x.transpose() +
-                                                      pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
-    const auto llt = cholesky_or_throw(S, "proposal innovation covariance");
-    if (gate_.rejects(llt, nu)) {
-      particle.log_weight += log_likelihood_at_gate_edge(llt);
-      rejected[i] = gated;
+    const auto innovation = proposal_innovation(std::move(*prediction), cov, L, known[i].z);
+    if (gate_.rejects(innovation.llt, innovation.nu)) {
+      particle.log_weight += log_likelihood_at_gate_edge(innovation.llt);
+      outcomes[i] = Outcome::gated;
       continue;
     }
-    const Eigen::Matrix<double, X, Z> K = llt.solve(pred.J_z_x * cov).transpose();
-    particle.log_weight += detail::log_gaussian(llt, nu);
-    mean = Space::plus(mean, K * nu);
-    cov = symmetrized((Eigen::Matrix<double, X, X>::Identity() - K * pred.J_z_x) * cov);
+    particle.log_weight += fold_into_proposal(mean, cov, innovation);
   }
   if (!std::isfinite(particle.log_weight)) throw numerical_error("FastSLAM 2.0 proposal weight is not finite");
   particle.x = sample(mean, cov, rng);
-  return rejected;
+  return outcomes;
+}
+
+/// One particle's known landmarks: with FastSLAM 2.0 the pose sampled from the proposal, then each
+/// landmark updated from it; with 1.0 each landmark updated and weighed (eq. 85).
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::update_known_landmarks(Particle& particle, std::span<const ObservationType> known,
+                                                           bool proposal, Transaction& t) const -> std::vector<Outcome> {
+  std::vector<Outcome> outcomes;
+  if (!proposal) {
+    for (const auto& observation : known) {
+      const auto result = update_landmark(particle, index_.at(observation.landmark_id), observation.z, false, true);
+      particle.log_weight += result.log_likelihood;
+      outcomes.push_back(result.outcome);
+    }
+    return outcomes;
+  }
+  const auto p = checked_motion_prediction(motion_, particle.x, t.pending.back().u, t.pending.back().dt);
+  outcomes = sample_v2_proposal(particle, p.x, p.R, known, t.rng);
+  for (std::size_t i = 0; i < known.size(); ++i)
+    if (outcomes[i] == Outcome::used &&
+        update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false, false).outcome == Outcome::unusable)
+      outcomes[i] = Outcome::unusable;  // behind the camera from the sampled pose
+  return outcomes;
 }
 
 /// Every step works on a copy of the particles (O(N) with shared maps) and of the random engine,
@@ -191,38 +226,19 @@ std::vector<char> FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& pa
 template <class Motion, class Sensor, template <class> class Map>
 UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationType> observations) {
   require_valid_observations(observations);
-  std::vector<ObservationType> known, fresh;
-  for (const auto& observation : observations)
-    (index_.contains(observation.landmark_id) ? known : fresh).push_back(observation);
+  const auto [known, fresh] = split_known_and_new(index_, observations);
   Transaction t = begin();
   const bool proposal = options_.version == FastSlamVersion::v2 && !t.pending.empty();
-  std::vector<std::vector<char>> rejected(t.particles.size());
-  for (std::size_t n = 0; n < t.particles.size(); ++n) {
-    auto& particle = t.particles[n];
-    if (proposal) {
-      const auto p = checked_motion_prediction(motion_, particle.x, t.pending.back().u, t.pending.back().dt);
-      rejected[n] = sample_v2_proposal(particle, p.x, p.R, known, t.rng);
-      for (std::size_t i = 0; i < known.size(); ++i)
-        if (rejected[n][i] == used) {
-          const auto outcome = update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false, false).outcome;
-          if (outcome == unusable) rejected[n][i] = unusable;  // behind the camera from the sampled pose
-        }
-    } else {
-      for (const auto& observation : known) {
-        const auto result = update_landmark(particle, index_.at(observation.landmark_id), observation.z, false, true);
-        particle.log_weight += result.log_likelihood;
-        rejected[n].push_back(result.outcome);
-      }
-    }
-  }
+  std::vector<std::vector<Outcome>> outcomes(t.particles.size());
+  for (std::size_t n = 0; n < t.particles.size(); ++n) outcomes[n] = update_known_landmarks(t.particles[n], known, proposal, t);
   UpdateResult result;
   const auto added = add_new_landmarks(t.particles, fresh, result.unusable);
   t.pending.clear();
-  const auto& best_rejected = rejected[best_particle(t.particles)];
+  const auto& best = outcomes[best_particle(t.particles)];
   std::size_t known_unusable = 0;
   for (std::size_t i = 0; i < known.size(); ++i) {
-    if (best_rejected[i] == gated) result.rejected.push_back(known[i].landmark_id);
-    if (best_rejected[i] == unusable) {
+    if (best[i] == Outcome::gated) result.rejected.push_back(known[i].landmark_id);
+    if (best[i] == Outcome::unusable) {
       result.unusable.push_back(known[i].landmark_id);
       ++known_unusable;
     }
@@ -282,60 +298,9 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
   for (const auto& z : measurements) require_finite(z, "unassociated measurement");
   Transaction t = begin();
   const bool proposal = options_.version == FastSlamVersion::v2 && !t.pending.empty();
-  constexpr std::size_t kNew = ~std::size_t{0};
   std::vector<std::size_t> started(t.particles.size(), 0);
-  for (std::size_t n = 0; n < t.particles.size(); ++n) {
-    auto& particle = t.particles[n];
-    State mean = particle.x;
-    Eigen::Matrix<double, X, X> cov = Eigen::Matrix<double, X, X>::Zero();
-    for (const auto& motion : t.pending) {
-      const auto p = checked_motion_prediction(motion_, mean, motion.u, motion.dt);
-      mean = proposal ? p.x : sample(p.x, p.R, t.rng);
-      if (proposal) cov = p.R;
-    }
-    std::vector<std::size_t> match(measurements.size(), kNew);
-    for (std::size_t i = 0; i < measurements.size(); ++i) {
-      double best_nis = options_.new_landmark_nis;
-      for (std::size_t j = 0; j < particle.unassociated.size(); ++j) {
-        const auto& L = particle.unassociated[j];
-        if (!L.alive) continue;
-        const auto pred = sensor_.predict(mean, L.mean);
-        const Eigen::Matrix<double, Z, Z> S = pred.J_z_x * cov * pred.J_z_x.transpose() +
-                                              pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q;
-        const double nis =
-            mahalanobis_squared(cholesky_or_throw(S, "association innovation"), sensor_.residual(measurements[i], pred.z));
-        if (nis < best_nis) best_nis = nis, match[i] = j;
-      }
-      if (proposal && match[i] != kNew) {  // fold the associated measurement into the proposal
-        const auto& L = particle.unassociated[match[i]];
-        const auto pred = sensor_.predict(mean, L.mean);
-        const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_x * cov * pred.J_z_x.transpose() +
-                                                          pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
-        const auto llt = cholesky_or_throw(S, "proposal innovation covariance");
-        const Eigen::Matrix<double, X, Z> K = llt.solve(pred.J_z_x * cov).transpose();
-        const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(measurements[i], pred.z);
-        particle.log_weight += detail::log_gaussian(llt, nu);
-        mean = Space::plus(mean, K * nu);
-        cov = symmetrized((Eigen::Matrix<double, X, X>::Identity() - K * pred.J_z_x) * cov);
-      }
-    }
-    particle.x = proposal ? sample(mean, cov, t.rng) : mean;
-    for (std::size_t i = 0; i < measurements.size(); ++i) {
-      if (match[i] != kNew) {
-        const double log_likelihood = update_landmark(particle, match[i], measurements[i], true, false).log_likelihood;
-        if (!proposal) particle.log_weight += log_likelihood;
-        continue;
-      }
-      const LandmarkId id = t.next_unassociated_id + i;
-      const auto init = initialize_landmark(sensor_, particle.x, measurements[i], id);
-      particle.unassociated.push_back({init.m, symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose()), true, id});
-      ++started[n];
-      // A new landmark weighs as a measurement on the gate's edge (the p0 of Montemerlo et al.).
-      particle.log_weight += detail::log_gaussian(cholesky_or_throw(init.Q, "measurement noise"),
-                                                  Eigen::Matrix<double, Z, 1>::Zero().eval()) -
-                             0.5 * options_.new_landmark_nis;
-    }
-  }
+  for (std::size_t n = 0; n < t.particles.size(); ++n)
+    started[n] = update_particle_unassociated(t.particles[n], measurements, proposal, t);
   t.pending.clear();
   t.next_unassociated_id += measurements.size();
   const std::size_t initialized = started[best_particle(t.particles)];
@@ -529,6 +494,65 @@ void FastSlam<Motion, Sensor, Map>::remove_landmark(LandmarkId id) {
   if (!found) throw unknown_landmark_error("unknown landmark id " + std::to_string(id));
   particles_.swap(particles);
   estimate_.reset();
+}
+
+/// The index of the landmark of `particle` each measurement goes to (kNewLandmark: none is within
+/// the new-landmark gate), the largest likelihood first; with the proposal (FastSLAM 2.0) each
+/// associated measurement is folded into (mean, cov) before the next is associated.
+template <class Motion, class Sensor, template <class> class Map>
+std::vector<std::size_t> FastSlam<Motion, Sensor, Map>::associate_in_particle(Particle& particle, State& mean,
+                                                                              PoseMatrix& cov,
+                                                                              std::span<const Measurement> measurements,
+                                                                              bool proposal) const {
+  std::vector<std::size_t> match(measurements.size(), kNewLandmark);
+  for (std::size_t i = 0; i < measurements.size(); ++i) {
+    double best_nis = options_.new_landmark_nis;
+    std::optional<ProposalInnovation> best;
+    for (std::size_t j = 0; j < particle.unassociated.size(); ++j) {
+      const auto& L = particle.unassociated[j];
+      if (!L.alive) continue;
+      auto innovation = proposal_innovation(sensor_.predict(mean, L.mean), cov, L, measurements[i]);
+      const double nis = mahalanobis_squared(innovation.llt, innovation.nu);
+      if (nis < best_nis) best_nis = nis, match[i] = j, best = std::move(innovation);
+    }
+    if (proposal && best) particle.log_weight += fold_into_proposal(mean, cov, *best);
+  }
+  return match;
+}
+
+/// One particle's step of update_unassociated: its pose over the pending motions (sampled, or with
+/// FastSLAM 2.0 the Gaussian proposal sampled after association), each measurement's landmark
+/// updated or started. Returns how many landmarks it started.
+template <class Motion, class Sensor, template <class> class Map>
+std::size_t FastSlam<Motion, Sensor, Map>::update_particle_unassociated(Particle& particle,
+                                                                        std::span<const Measurement> measurements,
+                                                                        bool proposal, Transaction& t) const {
+  State mean = particle.x;
+  PoseMatrix cov = PoseMatrix::Zero();
+  for (const auto& motion : t.pending) {
+    const auto p = checked_motion_prediction(motion_, mean, motion.u, motion.dt);
+    mean = proposal ? p.x : sample(p.x, p.R, t.rng);
+    if (proposal) cov = p.R;
+  }
+  const auto match = associate_in_particle(particle, mean, cov, measurements, proposal);
+  particle.x = proposal ? sample(mean, cov, t.rng) : mean;
+  std::size_t started = 0;
+  for (std::size_t i = 0; i < measurements.size(); ++i) {
+    if (match[i] != kNewLandmark) {
+      const double log_likelihood = update_landmark(particle, match[i], measurements[i], true, false).log_likelihood;
+      if (!proposal) particle.log_weight += log_likelihood;
+      continue;
+    }
+    const LandmarkId id = t.next_unassociated_id + i;
+    const auto init = initialize_landmark(sensor_, particle.x, measurements[i], id);
+    particle.unassociated.push_back({init.m, symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose()), true, id});
+    ++started;
+    // A new landmark weighs as a measurement on the gate's edge (the p0 of Montemerlo et al.).
+    particle.log_weight += detail::log_gaussian(cholesky_or_throw(init.Q, "measurement noise"),
+                                                Eigen::Matrix<double, Z, 1>::Zero().eval()) -
+                           0.5 * options_.new_landmark_nis;
+  }
+  return started;
 }
 
 }  // namespace sextant

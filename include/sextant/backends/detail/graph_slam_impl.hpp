@@ -9,6 +9,8 @@
 #include <utility>
 
 #include "sextant/core/landmark_init.hpp"
+#include "sextant/core/block_triplets.hpp"
+#include "sextant/core/factor_information.hpp"
 #include "sextant/core/linearized_observation.hpp"
 #include "sextant/core/sparse_cholesky.hpp"
 #include "sextant/core/validation.hpp"
@@ -41,28 +43,16 @@ struct GraphSlam<Motion, Sensor>::Linearization {
 
   /// The whole information matrix (poses, then landmarks in this system's order), whole blocks stored.
   Eigen::SparseMatrix<double> assemble() const {
-    std::vector<Eigen::Triplet<double>> triplets;
-    auto add = [&](Eigen::Index row, Eigen::Index col, const auto& block) {
-      for (Eigen::Index c = 0; c < block.cols(); ++c)
-        for (Eigen::Index r = 0; r < block.rows(); ++r) triplets.emplace_back(row + r, col + c, block(r, c));
-    };
-    for (std::size_t p = 0; p < pose_count; ++p) add(X * p, X * p, pose_diagonal[p]);
-    for (const auto& link : pose_links) {
-      add(X * link.a, X * link.b, link.block);
-      add(X * link.b, X * link.a, link.block.transpose());
-    }
+    BlockTriplets triplets;
+    for (std::size_t p = 0; p < pose_count; ++p) triplets.add(X * p, X * p, pose_diagonal[p]);
+    for (const auto& link : pose_links) triplets.add_symmetric(X * link.a, X * link.b, link.block);
     const Eigen::Index base = X * static_cast<Eigen::Index>(pose_count);
     for (std::size_t j = 0; j < landmarks.size(); ++j) {
       const Eigen::Index row = base + M * static_cast<Eigen::Index>(j);
-      add(row, row, landmarks[j].diagonal);
-      for (const auto& [p, block] : landmarks[j].poses) {
-        add(X * p, row, block);
-        add(row, X * p, block.transpose());
-      }
+      triplets.add(row, row, landmarks[j].diagonal);
+      for (const auto& [p, block] : landmarks[j].poses) triplets.add_symmetric(X * p, row, block);
     }
-    Eigen::SparseMatrix<double> out(dim(), dim());
-    out.setFromTriplets(triplets.begin(), triplets.end());
-    return out;
+    return triplets.to_sparse(dim(), dim());
   }
 };
 
@@ -99,7 +89,7 @@ void GraphSlam<Motion, Sensor>::predict(const Control& u, double dt) {
 template <class Motion, class Sensor>
 UpdateResult GraphSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
   require_valid_observations(observations);
-  const auto [known, fresh] = split_known_and_new(pool_, observations);
+  const auto [known, fresh] = split_known_and_new(landmarks_.pool(), observations);
   const std::size_t pose = poses_.size() - 1;
   // Linearize every new factor at the current estimate now, so that a factor no later
   // linearization could use (bad noise, an overflowing residual) is rejected where it enters
@@ -108,7 +98,7 @@ UpdateResult GraphSlam<Motion, Sensor>::update(std::span<const ObservationType> 
   UpdateResult result;
   std::vector<const ObservationType*> used;
   for (const auto& observation : known)
-    if (linearize_if_observable(sensor_, poses_[pose], landmark_mean(pool_.slot(observation.landmark_id)),
+    if (linearize_if_observable(sensor_, poses_[pose], landmark_mean(landmarks_.slot(observation.landmark_id)),
                                 observation.z, observation.landmark_id, 0, result.unusable))
       used.push_back(&observation);
   std::vector<std::pair<const ObservationType*, LandmarkInit<M, X, Z>>> inits;
@@ -122,12 +112,10 @@ UpdateResult GraphSlam<Motion, Sensor>::update(std::span<const ObservationType> 
     inits.emplace_back(&observation, std::move(*init));
   }
   for (const ObservationType* observation : used)
-    measurements_[pool_.slot(observation->landmark_id)].push_back({pose, observation->z});
+    measurements_[landmarks_.slot(observation->landmark_id)].push_back({pose, observation->z});
   for (const auto& [observation, init] : inits) {
-    pool_.add(observation->landmark_id);
+    landmarks_.add(observation->landmark_id, init.m);
     measurements_.push_back({{pose, observation->z}});
-    landmark_means_.conservativeResize(landmark_means_.size() + M);
-    landmark_means_.template tail<M>() = init.m;
   }
   touch();
   result.corrected = used.size();
@@ -180,46 +168,62 @@ BetweenFactor<GraphSlam<Motion, Sensor>::X> GraphSlam<Motion, Sensor>::motion_fa
   }
 }
 
-/// Residuals r = f(x) - target with Jacobians J, weights W: Omega += J^T W J, b -= J^T W r, cost += r^T W r.
-/// Prior r = minus(x_0, mu_0) (eq. 64); motion r = minus(x_k+1, g(x_k, u)), J = [-G, I] (eqs. 60-61);
-/// measurement r = -residual(z, h(x, m)), J = [J_z_x, J_z_m] (eqs. 62-63).
+/// The normal equations at the current estimate, factor by factor (core/factor_information.hpp):
+/// Omega += J^T W J, b += J^T W nu, cost += rho(nu^T C^-1 nu) for the prior (eq. 64), the motion
+/// factors (eqs. 60-61), the factors of marginalized landmarks and the measurements (eqs. 62-63).
 template <class Motion, class Sensor>
 auto GraphSlam<Motion, Sensor>::linearize(std::size_t pose_count) const -> Linearization {
-  using MatrixX = Eigen::Matrix<double, X, X>;
   Linearization sys;
   sys.pose_count = pose_count;
-  sys.pose_diagonal.assign(pose_count, MatrixX::Zero());
+  sys.pose_diagonal.assign(pose_count, Eigen::Matrix<double, X, X>::Zero());
   sys.pose_rhs = Eigen::VectorXd::Zero(X * static_cast<Eigen::Index>(pose_count));
-  auto rhs = [&](std::size_t p) { return sys.pose_rhs.template segment<X>(X * p); };
+  add_prior_factor(sys);
+  add_motion_factors(sys);
+  add_marginal_factors(sys);
+  add_measurement_factors(sys);
+  if (!std::isfinite(sys.cost) || !sys.pose_rhs.allFinite()) throw numerical_error("GraphSLAM linearization is not finite");
+  return sys;
+}
 
+/// The prior on the first pose, r = minus(x_0, mu_0) (eq. 64).
+template <class Motion, class Sensor>
+void GraphSlam<Motion, Sensor>::add_prior_factor(Linearization& sys) const {
   const Eigen::Matrix<double, X, 1> r0 = Space::minus(poses_[0], prior_.mean);
   sys.pose_diagonal[0] += prior_information_;
-  rhs(0) -= prior_information_ * r0;
+  sys.pose_rhs.template head<X>() -= prior_information_ * r0;
   sys.cost += r0.dot(prior_information_ * r0);
+}
 
-  for (std::size_t k = 0; k + 1 < pose_count; ++k) {
+/// Each motion factor between poses k and k + 1: residual r, Jacobians J_from, J_to (eqs. 60-61).
+template <class Motion, class Sensor>
+void GraphSlam<Motion, Sensor>::add_motion_factors(Linearization& sys) const {
+  for (std::size_t k = 0; k + 1 < sys.pose_count; ++k) {
     const BetweenFactor<X> factor = motion_factor(k);
-    const auto llt = cholesky_or_throw(factor.cov, "process noise of step " + std::to_string(k));
-    const MatrixX W_from = llt.solve(factor.J_from), W_to = llt.solve(factor.J_to);
-    const Eigen::Matrix<double, X, 1> W_r = llt.solve(factor.r);
-    sys.pose_diagonal[k] += factor.J_from.transpose() * W_from;
-    sys.pose_diagonal[k + 1] += factor.J_to.transpose() * W_to;
-    sys.pose_links.push_back({k, k + 1, factor.J_from.transpose() * W_to});
-    rhs(k) -= factor.J_from.transpose() * W_r;
-    rhs(k + 1) -= factor.J_to.transpose() * W_r;
-    sys.cost += factor.r.dot(W_r);
+    const GaussianNoise<X> noise(factor.cov, "process noise of step " + std::to_string(k));
+    const auto info = noise.information(factor.J_from, factor.J_to, (-factor.r).eval());
+    sys.pose_diagonal[k] += info.aa;
+    sys.pose_diagonal[k + 1] += info.bb;
+    sys.pose_links.push_back({k, k + 1, info.ab});
+    sys.pose_rhs.template segment<X>(X * k) += info.a;
+    sys.pose_rhs.template segment<X>(X * (k + 1)) += info.b;
+    sys.cost += info.squared_norm;
   }
+}
 
+/// The linear factors that marginalized landmarks left on their poses (remove_landmark), relinearized
+/// by the poses' moves since: b = eta - Lambda d, d = minus(x, linearization point).
+template <class Motion, class Sensor>
+void GraphSlam<Motion, Sensor>::add_marginal_factors(Linearization& sys) const {
   for (const auto& factor : linear_factors_) {
-    if (*std::max_element(factor.poses.begin(), factor.poses.end()) >= pose_count) continue;
+    if (*std::max_element(factor.poses.begin(), factor.poses.end()) >= sys.pose_count) continue;
     Eigen::VectorXd d(X * static_cast<Eigen::Index>(factor.poses.size()));
     for (std::size_t i = 0; i < factor.poses.size(); ++i)
       d.template segment<X>(X * i) = Space::minus(poses_[factor.poses[i]], factor.linearization[i]);
     const Eigen::VectorXd b = factor.eta - factor.Lambda * d;
     for (std::size_t i = 0; i < factor.poses.size(); ++i) {
-      rhs(factor.poses[i]) += b.template segment<X>(X * i);
+      sys.pose_rhs.template segment<X>(X * factor.poses[i]) += b.template segment<X>(X * i);
       for (std::size_t k = 0; k < factor.poses.size(); ++k) {
-        const MatrixX block = factor.Lambda.template block<X, X>(X * i, X * k);
+        const Eigen::Matrix<double, X, X> block = factor.Lambda.template block<X, X>(X * i, X * k);
         if (factor.poses[i] == factor.poses[k])
           sys.pose_diagonal[factor.poses[i]] += block;
         else if (factor.poses[i] < factor.poses[k])
@@ -228,35 +232,34 @@ auto GraphSlam<Motion, Sensor>::linearize(std::size_t pose_count) const -> Linea
     }
     sys.cost += d.dot(factor.Lambda * d) - 2.0 * factor.eta.dot(d);
   }
+}
 
+/// Each measurement of each landmark: innovation nu = residual(z, h(x, m)), Jacobians J_z_x, J_z_m
+/// (eqs. 62-63), down-weighted by the measurement loss.
+template <class Motion, class Sensor>
+void GraphSlam<Motion, Sensor>::add_measurement_factors(Linearization& sys) const {
   for (std::size_t slot = 0; slot < measurements_.size(); ++slot) {
     typename Linearization::LandmarkTerms terms;
     terms.slot = slot;
     for (const auto& record : measurements_[slot]) {
-      if (record.pose >= pose_count) continue;
+      if (record.pose >= sys.pose_count) continue;
       const auto prediction = predict_if_observable(poses_[record.pose], landmark_mean(slot));
       if (!prediction) {  // e.g. an iterate put the landmark behind this camera: the factor sits this one out
         ++sys.unobservable;
         continue;
       }
-      const Eigen::Matrix<double, Z, 1> r = -sensor_.residual(record.z, prediction->z);
-      const auto llt = cholesky_or_throw(prediction->Q, "measurement noise Q of landmark " + std::to_string(pool_.id_at(slot)));
-      const double s = r.dot(llt.solve(r));
-      const double w = options_.measurement_loss.weight(s);  // IRLS: rho'(s) W
-      const Eigen::Matrix<double, Z, X> W_Jx = w * llt.solve(prediction->J_z_x);
-      const Eigen::Matrix<double, Z, M> W_Jm = w * llt.solve(prediction->J_z_m);
-      const Eigen::Matrix<double, Z, 1> W_r = w * llt.solve(r);
-      sys.pose_diagonal[record.pose] += prediction->J_z_x.transpose() * W_Jx;
-      rhs(record.pose) -= prediction->J_z_x.transpose() * W_r;
-      terms.diagonal += prediction->J_z_m.transpose() * W_Jm;
-      terms.rhs -= prediction->J_z_m.transpose() * W_r;
-      terms.poses.emplace_back(record.pose, prediction->J_z_x.transpose() * W_Jm);
-      sys.cost += options_.measurement_loss.cost(s);
+      const GaussianNoise<Z> noise(prediction->Q, "measurement noise Q of landmark " + std::to_string(landmarks_.id_at(slot)));
+      const auto info = noise.information(prediction->J_z_x, prediction->J_z_m,
+                                          sensor_.residual(record.z, prediction->z), options_.measurement_loss);
+      sys.pose_diagonal[record.pose] += info.aa;
+      sys.pose_rhs.template segment<X>(X * record.pose) += info.a;
+      terms.diagonal += info.bb;
+      terms.rhs += info.b;
+      terms.poses.emplace_back(record.pose, info.ab);
+      sys.cost += options_.measurement_loss.cost(info.squared_norm);
     }
     if (!terms.poses.empty()) sys.landmarks.push_back(std::move(terms));
   }
-  if (!std::isfinite(sys.cost) || !sys.pose_rhs.allFinite()) throw numerical_error("GraphSLAM linearization is not finite");
-  return sys;
 }
 
 /// Thesis eqs. (66)-(69), (72)-(73): S = Omega_pp - sum_j Omega_pj Omega_jj^-1 Omega_jp,
@@ -266,21 +269,14 @@ Eigen::VectorXd GraphSlam<Motion, Sensor>::solve_by_landmark_schur(const Lineari
                                                                     OptimizationSummary& summary) const {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  std::vector<Eigen::Triplet<double>> triplets;
-  auto add = [&](std::size_t a, std::size_t b, const Eigen::Matrix<double, X, X>& block) {
-    for (int c = 0; c < X; ++c)
-      for (int r = 0; r < X; ++r) triplets.emplace_back(X * a + r, X * b + c, block(r, c));
-  };
-  for (std::size_t p = 0; p < sys.pose_count; ++p) add(p, p, sys.pose_diagonal[p]);
-  for (const auto& link : sys.pose_links) {
-    add(link.a, link.b, link.block);
-    add(link.b, link.a, link.block.transpose());
-  }
+  BlockTriplets triplets;  // S, pose blocks (a, b) at (X a, X b)
+  for (std::size_t p = 0; p < sys.pose_count; ++p) triplets.add(X * p, X * p, sys.pose_diagonal[p]);
+  for (const auto& link : sys.pose_links) triplets.add_symmetric(X * link.a, X * link.b, link.block);
   Eigen::VectorXd b = sys.pose_rhs;
   std::vector<Eigen::LLT<Eigen::Matrix<double, M, M>>> factors;
   factors.reserve(sys.landmarks.size());
   for (const auto& terms : sys.landmarks) {
-    factors.push_back(cholesky_or_throw(terms.diagonal, "information of landmark " + std::to_string(pool_.id_at(terms.slot))));
+    factors.push_back(cholesky_or_throw(terms.diagonal, "information of landmark " + std::to_string(landmarks_.id_at(terms.slot))));
     const auto& llt = factors.back();
     std::vector<Eigen::Matrix<double, M, X>> solved;  // Omega_jj^-1 Omega_jp
     for (const auto& [p, block] : terms.poses) solved.push_back(llt.solve(block.transpose()));
@@ -288,11 +284,11 @@ Eigen::VectorXd GraphSlam<Motion, Sensor>::solve_by_landmark_schur(const Lineari
     for (std::size_t a = 0; a < terms.poses.size(); ++a) {
       const auto& [p, block] = terms.poses[a];
       b.template segment<X>(X * p) -= block * solved_rhs;
-      for (std::size_t c = 0; c < terms.poses.size(); ++c) add(p, terms.poses[c].first, -(block * solved[c]));
+      for (std::size_t c = 0; c < terms.poses.size(); ++c)
+        triplets.add(X * p, X * terms.poses[c].first, Eigen::Matrix<double, X, X>(-(block * solved[c])));
     }
   }
-  Eigen::SparseMatrix<double> S(X * sys.pose_count, X * sys.pose_count);
-  S.setFromTriplets(triplets.begin(), triplets.end());
+  const Eigen::SparseMatrix<double> S = triplets.to_sparse(X * sys.pose_count, X * sys.pose_count);
   const auto eliminated = Clock::now();
   summary.seconds_eliminate += std::chrono::duration<double>(eliminated - start).count();
 
@@ -333,7 +329,7 @@ void GraphSlam<Motion, Sensor>::apply(const Linearization& sys, const Eigen::Vec
   for (std::size_t p = 0; p < sys.pose_count; ++p) poses_[p] = Space::plus(poses_[p], delta.template segment<X>(X * p));
   const Eigen::Index base = X * static_cast<Eigen::Index>(sys.pose_count);
   for (std::size_t j = 0; j < sys.landmarks.size(); ++j)
-    landmark_means_.template segment<M>(M * sys.landmarks[j].slot) += delta.template segment<M>(base + M * j);
+    landmarks_.means().slot(sys.landmarks[j].slot) += delta.template segment<M>(base + M * j);
 }
 
 /// One step of the (damped) normal equations: lambda > 0 adds lambda diag(Omega) (Marquardt).
@@ -401,13 +397,13 @@ OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_cou
     const Eigen::VectorXd delta = solve(sys, lambda, summary);
     if (!delta.allFinite()) throw numerical_error("GraphSLAM step is not finite");
     const std::vector<State> poses_before = lambda > 0.0 ? poses_ : std::vector<State>{};
-    const Eigen::VectorXd means_before = lambda > 0.0 ? landmark_means_ : Eigen::VectorXd{};
+    const Eigen::VectorXd means_before = lambda > 0.0 ? landmarks_.means().stacked() : Eigen::VectorXd{};
     apply(sys, delta);
     Linearization next = timed_linearize();
     ++summary.iterations;
     if (lambda > 0.0 && next.cost > sys.cost) {  // rejected: back to where we were, damp more
       poses_ = poses_before;
-      landmark_means_ = means_before;
+      landmarks_.means().stacked() = means_before;
       lambda *= 10.0;
       record_cost(sys.cost);
       continue;
@@ -437,8 +433,7 @@ void GraphSlam<Motion, Sensor>::reinitialize_after(std::size_t pose_count) {
   for (std::size_t slot = 0; slot < measurements_.size(); ++slot) {
     const auto& first = measurements_[slot].front();
     if (first.pose >= pose_count)
-      landmark_means_.template segment<M>(M * slot) =
-          initialize_landmark(sensor_, poses_[first.pose], first.z, pool_.id_at(slot)).m;
+      landmarks_.means().slot(slot) = initialize_landmark(sensor_, poses_[first.pose], first.z, landmarks_.id_at(slot)).m;
   }
 }
 
@@ -455,21 +450,17 @@ void GraphSlam<Motion, Sensor>::initialize_in_windows() {
 
 template <class Motion, class Sensor>
 OptimizationSummary GraphSlam<Motion, Sensor>::optimize() {
-  const std::vector<State> poses_before = poses_;
-  const Eigen::VectorXd means_before = landmark_means_;
-  const bool windows_done_before = windows_done_;
   try {
+    RollbackGuard guard(poses_, landmarks_.means(), windows_done_);
     if (options_.window > 0 && !windows_done_) initialize_in_windows();
     Linearization final_system;
     OptimizationSummary summary = gauss_newton(poses_.size(), options_.max_iterations, &final_system);
     newest_cov_ = newest_pose_marginal(final_system);
+    guard.commit();
     touch();
     return summary;
   } catch (...) {
-    poses_ = poses_before;
-    landmark_means_ = means_before;
-    windows_done_ = windows_done_before;
-    touch();
+    touch();  // after the guard's restore: a new version, never an old one
     throw;
   }
 }
@@ -479,13 +470,13 @@ void GraphSlam<Motion, Sensor>::warm_start(std::span<const State> poses, const M
   if (poses.size() != poses_.size())
     throw invalid_input_error("warm_start: " + std::to_string(poses.size()) + " poses given, the graph has " +
                               std::to_string(poses_.size()));
-  Eigen::VectorXd means = landmark_means_;
-  for (const auto& landmark : map) means.template segment<M>(M * pool_.slot(landmark.id)) = landmark.mean;
+  Eigen::VectorXd means = landmarks_.means().stacked();
+  for (const auto& landmark : map) means.template segment<M>(M * landmarks_.slot(landmark.id)) = landmark.mean;
   for (const auto& pose : poses)
     if (!Space::is_finite(pose)) throw invalid_input_error("warm_start: a pose contains NaN or Inf");
   if (!means.allFinite()) throw invalid_input_error("warm_start: a landmark contains NaN or Inf");
   poses_.assign(poses.begin(), poses.end());
-  landmark_means_ = means;
+  landmarks_.means().stacked() = means;
   windows_done_ = true;
   touch();
 }
@@ -494,7 +485,7 @@ void GraphSlam<Motion, Sensor>::warm_start(std::span<const State> poses, const M
 /// factors over (poses P, landmark j) become Lambda = A_PP - A_Pj A_jj^-1 A_jP, eta = b_P - A_Pj A_jj^-1 b_j.
 template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
-  const std::size_t slot = pool_.slot(id);
+  const std::size_t slot = landmarks_.slot(id);
   std::map<std::size_t, std::size_t> index;  // pose -> position in the factor
   for (const auto& record : measurements_[slot]) index.emplace(record.pose, 0);
   std::size_t next = 0;
@@ -506,14 +497,14 @@ void GraphSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
   Eigen::Matrix<double, M, 1> b_j = Eigen::Matrix<double, M, 1>::Zero();
   for (const auto& record : measurements_[slot]) {
     const auto prediction = sensor_.predict(poses_[record.pose], landmark_mean(slot));
-    const Eigen::Matrix<double, Z, 1> r = -sensor_.residual(record.z, prediction.z);
-    const auto llt = cholesky_or_throw(prediction.Q, "measurement noise Q of landmark " + std::to_string(id));
+    const GaussianNoise<Z> noise(prediction.Q, "measurement noise Q of landmark " + std::to_string(id));
+    const auto info = noise.information(prediction.J_z_x, prediction.J_z_m, sensor_.residual(record.z, prediction.z));
     const Eigen::Index at = X * static_cast<Eigen::Index>(index[record.pose]);
-    A_PP.template block<X, X>(at, at) += prediction.J_z_x.transpose() * llt.solve(prediction.J_z_x);
-    A_Pj.template middleRows<X>(at) += prediction.J_z_x.transpose() * llt.solve(prediction.J_z_m);
-    A_jj += prediction.J_z_m.transpose() * llt.solve(prediction.J_z_m);
-    b_P.template segment<X>(at) -= prediction.J_z_x.transpose() * llt.solve(r);
-    b_j -= prediction.J_z_m.transpose() * llt.solve(r);
+    A_PP.template block<X, X>(at, at) += info.aa;
+    A_Pj.template middleRows<X>(at) += info.ab;
+    A_jj += info.bb;
+    b_P.template segment<X>(at) += info.a;
+    b_j += info.b;
   }
   const auto llt = cholesky_or_throw(A_jj, "information of landmark " + std::to_string(id));
   LinearFactor factor;
@@ -525,11 +516,9 @@ void GraphSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
   factor.eta = b_P - A_Pj * llt.solve(b_j);
   linear_factors_.push_back(std::move(factor));
 
-  const auto removal = pool_.remove(id);
+  const auto removal = landmarks_.remove(id);
   measurements_[removal.freed_slot] = std::move(measurements_[removal.last_slot]);
   measurements_.pop_back();
-  landmark_means_.template segment<M>(M * removal.freed_slot) = landmark_means_.template segment<M>(M * removal.last_slot);
-  landmark_means_.conservativeResize(landmark_means_.size() - M);
   touch();
 }
 
@@ -549,7 +538,7 @@ auto GraphSlam<Motion, Sensor>::trajectory() const -> std::vector<PoseEstimate> 
 
 template <class Motion, class Sensor>
 auto GraphSlam<Motion, Sensor>::landmark(LandmarkId id) const -> LandmarkEstimate<M> {
-  const std::size_t slot = pool_.slot(id);
+  const std::size_t slot = landmarks_.slot(id);
   const Eigen::Index at = X * static_cast<Eigen::Index>(poses_.size()) + M * static_cast<Eigen::Index>(slot);
   return {id, landmark_mean(slot), marginals()->block(at, M)};
 }
@@ -557,7 +546,7 @@ auto GraphSlam<Motion, Sensor>::landmark(LandmarkId id) const -> LandmarkEstimat
 template <class Motion, class Sensor>
 auto GraphSlam<Motion, Sensor>::map() const -> MapEstimate {
   MapEstimate out;
-  for (LandmarkId id : pool_.ids()) out.push_back(landmark(id));
+  for (LandmarkId id : landmarks_.ids()) out.push_back(landmark(id));
   return out;
 }
 

@@ -8,6 +8,7 @@
 #include <unordered_set>
 #include <utility>
 
+#include "sextant/core/factor_information.hpp"
 #include "sextant/core/landmark_init.hpp"
 #include "sextant/core/validation.hpp"
 
@@ -72,27 +73,20 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::linearize(const ObservationType& observation, std::vector<LandmarkId>& unusable) const
     -> std::optional<Linearized> {
-  const std::size_t slot = pool_.slot(observation.landmark_id);
+  const std::size_t slot = landmarks_.slot(observation.landmark_id);
   auto lin = linearize_if_observable(sensor_, x_, landmark_mean(slot), observation.z, observation.landmark_id,
                                      offset_of(slot), unusable);
   if (lin && options_.first_estimate_jacobians)
-    use_first_estimate_jacobians(sensor_, x_, Landmark(first_means_.at(slot)), observation.z, *lin);
+    use_first_estimate_jacobians(sensor_, x_, Landmark(landmarks_.first_mean(slot)), observation.z, *lin);
   return lin;
 }
 
 /// H^T Q^-1 H and H^T Q^-1 nu of one observation, by blocks (thesis eqs. 29-30).
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::measurement_information(const Linearized& lin) const -> MeasurementInformation {
-  const auto llt = cholesky_or_throw(lin.Q, "measurement noise Q of landmark " + std::to_string(lin.id));
-  const Eigen::Matrix<double, Z, X> W_Hx = llt.solve(lin.J_z_x);
-  const Eigen::Matrix<double, Z, M> W_Hm = llt.solve(lin.J_z_m);
-  const Eigen::Matrix<double, Z, 1> W_nu = llt.solve(lin.residual);
-  return {pool_.slot(lin.id),
-          symmetrized(lin.J_z_x.transpose() * W_Hx),
-          lin.J_z_x.transpose() * W_Hm,
-          symmetrized(lin.J_z_m.transpose() * W_Hm),
-          lin.J_z_x.transpose() * W_nu,
-          lin.J_z_m.transpose() * W_nu};
+  const GaussianNoise<Z> noise(lin.Q, "measurement noise Q of landmark " + std::to_string(lin.id));
+  const auto info = noise.information(lin.J_z_x, lin.J_z_m, lin.residual);
+  return {landmarks_.slot(lin.id), symmetrized(info.aa), info.ab, symmetrized(info.bb), info.a, info.b};
 }
 
 /// A new landmark in information form: the conditional m = init.m + J_m_x dx + v, v ~ N(0, C),
@@ -122,11 +116,8 @@ void SeifSlam<Motion, Sensor>::add(const MeasurementInformation& info) {
 
 template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::augment(const NewLandmark& landmark) {
-  const std::size_t slot = pool_.add(landmark.id);
+  const std::size_t slot = landmarks_.add(landmark.id, landmark.mean);
   info_.append_landmark();
-  landmark_means_.conservativeResize(landmark_means_.size() + M);
-  landmark_means_.template tail<M>() = landmark.mean;
-  first_means_.append(landmark.mean);
   info_.robot() += landmark.xx;
   info_.add_to_robot_link(slot, landmark.xm);
   info_.diagonal(slot) = landmark.mm;
@@ -139,7 +130,7 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
   auto stage_start = Clock::now();
   SeifUpdateTimes times;
   require_valid_observations(observations);
-  const auto [known, fresh] = split_known_and_new(pool_, observations);
+  const auto [known, fresh] = split_known_and_new(landmarks_.pool(), observations);
   // Linearize everything first; the rest runs as one transaction, undone if any step throws.
   std::vector<Linearized> linearized;
   linearized.reserve(known.size());
@@ -165,7 +156,7 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
     }
     for (const auto& landmark : landmarks) {
       augment(landmark);
-      observed.push_back(pool_.size() - 1);
+      observed.push_back(landmarks_.size() - 1);
     }
     times.measurement_s = seconds_since(stage_start);
     stage_start = Clock::now();
@@ -213,7 +204,7 @@ void SeifSlam<Motion, Sensor>::gate(std::vector<Linearized>& observations, std::
 template <class Motion, class Sensor>
 template <class Step>
 void SeifSlam<Motion, Sensor>::atomically(Step step) {
-  Undo undo{x_, {}, {}, active_queue_, updates_, pool_.size()};
+  Undo undo{x_, {}, {}, active_queue_, updates_, landmarks_.size()};
   undo_ = &undo;
   info_.begin_transaction();
   try {
@@ -224,12 +215,10 @@ void SeifSlam<Motion, Sensor>::atomically(Step step) {
   } catch (...) {
     info_.rollback();
     undo_ = nullptr;
-    while (pool_.size() > undo.landmarks) pool_.remove(pool_.id_at(pool_.size() - 1));
-    if (undo.all_means) landmark_means_ = std::move(*undo.all_means);
-    landmark_means_.conservativeResize(M * static_cast<Eigen::Index>(undo.landmarks));
-    first_means_.truncate(undo.landmarks);
+    if (undo.all_means) landmarks_.means().stacked() = std::move(*undo.all_means);
+    landmarks_.truncate(undo.landmarks);
     for (auto it = undo.means.rbegin(); it != undo.means.rend(); ++it)  // oldest saved value last
-      landmark_means_.template segment<M>(M * it->first) = it->second;
+      landmarks_.means().slot(it->first) = it->second;
     x_ = undo.x;
     active_queue_ = std::move(undo.active_queue);
     updates_ = undo.updates;
@@ -242,7 +231,7 @@ void SeifSlam<Motion, Sensor>::atomically(Step step) {
 template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::move_landmark_mean(std::size_t slot, const Eigen::Matrix<double, M, 1>& dm) {
   if (undo_ && slot < undo_->landmarks && !undo_->all_means) undo_->means.emplace_back(slot, landmark_mean(slot));
-  landmark_means_.template segment<M>(M * slot) += dm;
+  landmarks_.means().slot(slot) += dm;
 }
 
 /// Overflow shows up first in the blocks a step touched: the robot's and the active landmarks'.
@@ -354,9 +343,9 @@ void SeifSlam<Motion, Sensor>::recover_mean_exactly_in_transaction() {
   const Eigen::VectorXd r = info_.residual();
   const Eigen::VectorXd delta = factor.solve(r);
   if (!delta.allFinite()) throw numerical_error("exact mean recovery is not finite");
-  if (undo_ && !undo_->all_means) undo_->all_means = landmark_means_;
+  if (undo_ && !undo_->all_means) undo_->all_means = landmarks_.means().stacked();
   x_ = Space::plus(x_, delta.template head<X>());
-  landmark_means_ += delta.tail(delta.size() - X);
+  landmarks_.means().stacked() += delta.tail(delta.size() - X);
   info_.set_residual(r - omega * delta);
 }
 
@@ -434,12 +423,9 @@ void SeifSlam<Motion, Sensor>::sparsify() {
 
 template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
-  const std::size_t slot = pool_.slot(id);
+  const std::size_t slot = landmarks_.slot(id);
   info_.marginalize_landmark(slot);  // throws before changing anything
-  const auto removal = pool_.remove(id);
-  landmark_means_.template segment<M>(M * removal.freed_slot) = landmark_means_.template segment<M>(M * removal.last_slot);
-  landmark_means_.conservativeResize(landmark_means_.size() - M);
-  first_means_.move_last_into(removal.freed_slot);
+  const auto removal = landmarks_.remove(id);
   std::vector<std::size_t> queue;
   for (std::size_t s : active_queue_)
     if (s != removal.freed_slot) queue.push_back(s == removal.last_slot ? removal.freed_slot : s);
@@ -483,13 +469,7 @@ Eigen::MatrixXd SeifSlam<Motion, Sensor>::joint_covariance(const std::vector<Eig
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::joint_marginal(std::span<const LandmarkId> ids) const -> JointMarginal<State, M> {
   JointMarginal<State, M> out{x_, {ids.begin(), ids.end()}, {}, {}};
-  std::vector<Eigen::Index> offsets;
-  for (const LandmarkId id : ids) {
-    const std::size_t slot = pool_.slot(id);
-    out.landmarks.push_back(landmark_mean(slot));
-    offsets.push_back(offset_of(slot));
-  }
-  out.cov = joint_covariance(offsets);
+  out.cov = joint_covariance(landmarks_.template gather<X>(ids, out.landmarks));
   return out;
 }
 
@@ -500,23 +480,23 @@ auto SeifSlam<Motion, Sensor>::pose() const -> PoseEstimate {
 
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::landmark(LandmarkId id) const -> LandmarkEstimate<M> {
-  const std::size_t slot = pool_.slot(id);
+  const std::size_t slot = landmarks_.slot(id);
   return {id, landmark_mean(slot), marginal_covariance(offset_of(slot), M)};
 }
 
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::map() const -> MapEstimate {
   MapEstimate out;
-  out.reserve(pool_.size());
+  out.reserve(landmarks_.size());
   constexpr std::size_t kChunk = 32;  // landmarks per multi-right-hand-side solve
   const auto factor = factorization();
-  for (std::size_t first = 0; first < pool_.size(); first += kChunk) {
-    const std::size_t count = std::min(kChunk, pool_.size() - first);
+  for (std::size_t first = 0; first < landmarks_.size(); first += kChunk) {
+    const std::size_t count = std::min(kChunk, landmarks_.size() - first);
     Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(state_dim(), M * static_cast<Eigen::Index>(count));
     unit.block(offset_of(first), 0, unit.cols(), unit.cols()).setIdentity();
     const Eigen::MatrixXd columns = factor->solve(unit);
     for (std::size_t k = 0; k < count; ++k)
-      out.push_back({pool_.id_at(first + k), landmark_mean(first + k),
+      out.push_back({landmarks_.id_at(first + k), landmark_mean(first + k),
                      symmetrized(columns.template block<M, M>(offset_of(first + k), M * k))});
   }
   return out;
@@ -525,7 +505,7 @@ auto SeifSlam<Motion, Sensor>::map() const -> MapEstimate {
 template <class Motion, class Sensor>
 std::vector<LandmarkId> SeifSlam<Motion, Sensor>::active_landmarks() const {
   std::vector<LandmarkId> out;
-  for (std::size_t slot : active_queue_) out.push_back(pool_.id_at(slot));
+  for (std::size_t slot : active_queue_) out.push_back(landmarks_.id_at(slot));
   return out;
 }
 

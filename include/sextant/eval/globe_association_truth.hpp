@@ -13,17 +13,17 @@
 #include "sextant/sim/globe_render.hpp"
 #include "sextant/vision/stereo_tracker.hpp"
 
-namespace sextant::vision {
+namespace sextant::eval {
 
 class GlobeAssociationTruth {
  public:
   explicit GlobeAssociationTruth(sim::GlobeCameraOptions options) : options_(options) {}
 
   /// Scores one tracked frame seen from the true pose x.
-  void score(const Vector12d& x, const TrackedFrame& frame) {
+  void score(const Vector12d& x, const vision::TrackedFrame& frame) {
     for (std::size_t k = 0; k < frame.observations.size(); ++k) {
       const LandmarkId id = frame.observations[k].landmark_id;
-      const StereoFeature& f = frame.observed[k];
+      const vision::StereoFeature& f = frame.observed[k];
       if (frame.is_new[k]) {
         if (const auto m = sim::surface_point(options_, x, f.left_px.x(), f.left_px.y())) true_points_.emplace(id, *m);
         continue;
@@ -41,7 +41,7 @@ class GlobeAssociationTruth {
   const std::map<LandmarkId, Eigen::Vector3d>& true_landmarks() const { return true_points_; }
 
  private:
-  bool seen_at(const Vector12d& x, const Eigen::Vector3d& m, const StereoFeature& f) const {
+  bool seen_at(const Vector12d& x, const Eigen::Vector3d& m, const vision::StereoFeature& f) const {
     const Eigen::Vector3d p = x.head<3>();
     if (m.dot(p - m) <= 0.0) return false;  // on the far hemisphere
     const Eigen::Vector3d q = euler_yxz::rotation(x.segment<3>(3)).transpose() * (m - p);
@@ -57,4 +57,4 @@ class GlobeAssociationTruth {
   std::size_t associated_ = 0, right_ = 0;
 };
 
-}  // namespace sextant::vision
+}  // namespace sextant::eval

@@ -1,0 +1,35 @@
+#pragma once
+/// \file The one block-sparse assembly: dense blocks written into a sparse matrix at (row, col),
+/// entries that meet summed (Eigen's setFromTriplets), in the order the blocks were added. GraphSLAM's
+/// normal equations and reduced system and SEIF's information matrix are assembled with it.
+
+#include <Eigen/SparseCore>
+#include <vector>
+
+namespace sextant {
+
+class BlockTriplets {
+ public:
+  /// block at rows [row, row + block.rows()), columns [col, col + block.cols()).
+  template <class Block>
+  void add(Eigen::Index row, Eigen::Index col, const Block& block) {
+    for (Eigen::Index c = 0; c < block.cols(); ++c)
+      for (Eigen::Index r = 0; r < block.rows(); ++r) triplets_.emplace_back(row + r, col + c, block(r, c));
+  }
+  /// block at (row, col) and its transpose at (col, row): an off-diagonal block of a symmetric matrix.
+  template <class Block>
+  void add_symmetric(Eigen::Index row, Eigen::Index col, const Block& block) {
+    add(row, col, block);
+    add(col, row, block.transpose());
+  }
+  Eigen::SparseMatrix<double> to_sparse(Eigen::Index rows, Eigen::Index cols) const {
+    Eigen::SparseMatrix<double> out(rows, cols);
+    out.setFromTriplets(triplets_.begin(), triplets_.end());
+    return out;
+  }
+
+ private:
+  std::vector<Eigen::Triplet<double>> triplets_;
+};
+
+}  // namespace sextant
