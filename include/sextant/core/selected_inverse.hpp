@@ -38,12 +38,14 @@ class SelectedInverse {
   /// if A is not positive definite.
   explicit SelectedInverse(const SparseMatrix& A, Method method = Method::automatic) {
     if (A.rows() != A.cols()) throw invalid_input_error("selected inverse of a non-square matrix");
-    if (method == Method::automatic) method = automatic_method(A);
+    std::optional<Ordered> ordered;  // the AMD ordering, computed once for the choice and the factor
+    if (method != Method::dense) ordered = fill_reducing_permuted(A);
+    if (method == Method::automatic) method = method_for(*ordered);
     method_ = method;
     if (method == Method::dense)
       invert_densely(A);
     else
-      invert_sparsely(A);
+      invert_sparsely(*ordered);
   }
 
   Eigen::Index rows() const { return n_; }
@@ -76,20 +78,24 @@ class SelectedInverse {
   /// The method `automatic` takes for A: dense when Takahashi's recursion would do more work (one
   /// look-up per pair of entries in a column of the factor) than the dense method's ~2/3 n^3 flops
   /// (factorization and triangular inverse), and n <= dense_limit. Costs one symbolic analysis.
-  static Method automatic_method(const SparseMatrix& A) {
-    const Eigen::Index n = A.rows();
-    if (n > dense_limit) return Method::sparse;
-    double sparse_work = 0.0;
-    for (Eigen::Index count : factor_column_counts(A)) sparse_work += static_cast<double>(count) * static_cast<double>(count);
-    const double dense_work = 2.0 / 3.0 * static_cast<double>(n) * static_cast<double>(n) * static_cast<double>(n);
-    return lookup_cost_in_flops * sparse_work > dense_work ? Method::dense : Method::sparse;
-  }
+  static Method automatic_method(const SparseMatrix& A) { return method_for(fill_reducing_permuted(A)); }
 
   /// Off-diagonal entries in each column of the Cholesky factor of P A P^T, P the fill-reducing
   /// (AMD) ordering the sparse method uses: the elimination tree walked row by row (each row of
   /// the factor is the union of the tree paths from the row's entries in A up to the diagonal).
   static std::vector<Eigen::Index> factor_column_counts(const SparseMatrix& A) {
-    const SparseMatrix C = fill_reducing_permuted(A);
+    return column_counts(fill_reducing_permuted(A).C);
+  }
+
+ private:
+  /// A symmetric matrix in the AMD ordering: C = P A P^T, its upper triangle stored (as Eigen's
+  /// SimplicialLDLT stores it after its own ordering, so that the factor is the same to the bit).
+  struct Ordered {
+    SparseMatrix C;
+    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P;
+  };
+  /// The factor's column counts of an ordered matrix (factor_column_counts).
+  static std::vector<Eigen::Index> column_counts(const SparseMatrix& C) {
     const Eigen::Index n = C.cols();
     std::vector<Eigen::Index> parent(n, -1), tag(n, -1), count(n, 0);
     for (Eigen::Index k = 0; k < n; ++k) {
@@ -105,19 +111,32 @@ class SelectedInverse {
     return count;
   }
 
- private:
-  using Factor = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>;
+  /// The automatic choice for an ordered matrix (automatic_method).
+  static Method method_for(const Ordered& ordered) {
+    const Eigen::Index n = ordered.C.rows();
+    if (n > dense_limit) return Method::sparse;
+    double sparse_work = 0.0;
+    for (Eigen::Index count : column_counts(ordered.C)) sparse_work += static_cast<double>(count) * static_cast<double>(count);
+    const double dense_work = 2.0 / 3.0 * static_cast<double>(n) * static_cast<double>(n) * static_cast<double>(n);
+    return lookup_cost_in_flops * sparse_work > dense_work ? Method::dense : Method::sparse;
+  }
 
-  static SparseMatrix fill_reducing_permuted(const SparseMatrix& A) {
+  /// The factor of the ordered matrix: its ordering is AMD's, computed once (fill_reducing_permuted),
+  /// so the factorization keeps it as it is.
+  using Factor = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Upper, Eigen::NaturalOrdering<int>>;
+
+  static Ordered fill_reducing_permuted(const SparseMatrix& A) {
     const SparseMatrix full = A.selfadjointView<Eigen::Lower>();
     Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> inverse;
     Eigen::AMDOrdering<int>()(full, inverse);
     // AMD gives the inverse permutation; a permutation's inverse is its transpose (an exact
-    // re-indexing, no arithmetic).
-    const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P = inverse.transpose();
-    SparseMatrix C;
-    C = A.selfadjointView<Eigen::Lower>().twistedBy(P);
-    return C;
+    // re-indexing, no arithmetic). This is the permutation Eigen's SimplicialLDLT with AMD ordering
+    // computes and applies itself.
+    Ordered out;
+    out.P = inverse.transpose();
+    out.C.resize(A.rows(), A.cols());
+    out.C.selfadjointView<Eigen::Upper>() = A.selfadjointView<Eigen::Lower>().twistedBy(out.P);
+    return out;
   }
 
   static void throw_not_positive_definite() { throw numerical_error("matrix to invert is not positive definite"); }
@@ -154,12 +173,13 @@ class SelectedInverse {
 
   // ---- sparse: Takahashi on the pattern of the LDL^T factor --------------------------------------
 
-  void invert_sparsely(const SparseMatrix& A) {
-    ldlt_.emplace(A);
+  void invert_sparsely(const Ordered& ordered) {
+    ldlt_.emplace(ordered.C);
     if (ldlt_->info() != Eigen::Success) throw_not_positive_definite();
     const Eigen::VectorXd d = ldlt_->vectorD();
     if ((d.array() <= 0.0).any()) throw_not_positive_definite();
-    n_ = A.rows();
+    n_ = ordered.C.rows();
+    permutation_ = ordered.P.indices().cast<Eigen::Index>();
     compute(d);
   }
 
@@ -208,7 +228,6 @@ class SelectedInverse {
       for (Eigen::Index b = first; b < last; ++b) sum += values[b] * off_diagonal_[b];
       diagonal_[j] = 1.0 / d[j] - sum;
     }
-    permutation_ = ldlt_->permutationP().indices().cast<Eigen::Index>();
   }
 
   Method method_ = Method::sparse;
