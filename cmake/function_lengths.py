@@ -61,9 +61,19 @@ def functions(path):
     scopes = []  # (kind, name, start line)
     head_start = 0
     line = 1
+    parens = 0  # braces inside parentheses (a default argument's {}, a lambda in a call) are no bodies
     for i, c in enumerate(text):
         if c == "\n":
             line += 1
+        if c in "()":
+            parens += 1 if c == "(" else -1
+            continue
+        if parens > 0:
+            if c == "{":
+                scopes.append(("other", "", line))
+            elif c == "}" and scopes:
+                scopes.pop()
+            continue
         if c in ";{}":
             if c == "{":
                 head = text[head_start:i]

@@ -5,7 +5,11 @@
 // output, checked by a test). An unknown section or key, or a value that does not parse, is an
 // error naming the file, the section and the key.
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <fstream>
+#include <map>
 #include <cstdio>
 #include <limits>
 #include <filesystem>
@@ -101,12 +105,14 @@ inline double parse_number(const std::string& text) {
   return *value;
 }
 
-/// An integer of type T in [min, max], where max is T's largest value or 2^53 (the largest up to
-/// which every integer is a double), whichever is smaller: no value is silently truncated.
+/// An integer of type T in [min, max], max at most T's largest value or 2^53 (the largest up to which
+/// every integer is a double), whichever is smaller: no value is silently truncated. Counts that
+/// size memory (steps, particles, landmarks) pass their documented limit as `limit`
+/// (docs/reliability.md), so that a typo is an error naming the key, not std::bad_alloc.
 template <class T>
-T parse_integer(const std::string& text, long long min) {
+T parse_integer(const std::string& text, long long min, double limit = 9007199254740992.0) {
   const double value = parse_number(text);
-  const double max = std::min(static_cast<double>(std::numeric_limits<T>::max()), 9007199254740992.0);
+  const double max = std::min({static_cast<double>(std::numeric_limits<T>::max()), 9007199254740992.0, limit});
   if (value != std::floor(value) || value < static_cast<double>(min) || value > max) {
     char range[64];
     std::snprintf(range, sizeof range, "[%lld, %.0f]", min, max);
@@ -178,9 +184,9 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"ship", "seed", "1", "first simulation seed of the 2D beacon-ship Monte Carlo runs",
        [](RunnerConfig& c, const std::string& v) { c.ship.seed = parse_integer<std::uint64_t>(v, 0); }},
       {"ship", "runs", "10", "Monte Carlo runs (seeds seed .. seed+runs-1); the table averages them",
-       [](RunnerConfig& c, const std::string& v) { c.ship_runs = parse_integer<int>(v, 1); }},
+       [](RunnerConfig& c, const std::string& v) { c.ship_runs = parse_integer<int>(v, 1, 1e5); }},
       {"ship", "steps", "1390", "steps per run (thesis: 1390)",
-       [](RunnerConfig& c, const std::string& v) { c.ship.num_steps = parse_integer<int>(v, 1); }},
+       [](RunnerConfig& c, const std::string& v) { c.ship.num_steps = parse_integer<int>(v, 1, 1e7); }},
       {"ship", "sigma_heading_deg", "15", "compass noise, degrees (thesis: 15)",
        [](RunnerConfig& c, const std::string& v) { c.ship.sigma_heading = positive(parse_number(v), v) * deg; }},
       {"ship", "sigma_beacon", "2", "beacon offset noise per axis, km",
@@ -188,27 +194,27 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"globe", "seed", "1", "simulation seed of the globe (12D camera) experiment",
        [](RunnerConfig& c, const std::string& v) { c.globe.seed = parse_integer<std::uint64_t>(v, 0); }},
       {"globe", "steps", "500", "steps (thesis: 500); the circle closes near step 420",
-       [](RunnerConfig& c, const std::string& v) { c.globe.steps = parse_integer<int>(v, 1); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.steps = parse_integer<int>(v, 1, 1e6); }},
       {"globe", "points", "3000", "feature points on the globe",
-       [](RunnerConfig& c, const std::string& v) { c.globe.points = parse_integer<int>(v, 1); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.points = parse_integer<int>(v, 1, 1e7); }},
       {"globe", "features_per_frame", "120", "strongest visible points observed per frame",
-       [](RunnerConfig& c, const std::string& v) { c.globe.features_per_frame = parse_integer<int>(v, 1); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.features_per_frame = parse_integer<int>(v, 1, 1e5); }},
       {"globe", "max_landmarks", "1000", "landmark pool capacity Mmax (thesis: 1000)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_landmarks = parse_integer<std::size_t>(v, 1); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_landmarks = parse_integer<std::size_t>(v, 1, 1e6); }},
       {"globe", "max_new_per_step", "50", "new landmarks per step at most (thesis: 50)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_new_per_step = parse_integer<std::size_t>(v, 1); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_new_per_step = parse_integer<std::size_t>(v, 1, 1e6); }},
       {"globe", "seif_active", "150 250 0", "SEIF runs, one per value: active landmarks (0 = all)",
        [](RunnerConfig& c, const std::string& v) {
          std::istringstream in(v);
          std::vector<std::size_t> values;
-         for (std::string word; in >> word;) values.push_back(parse_integer<std::size_t>(word, 0));
+         for (std::string word; in >> word;) values.push_back(parse_integer<std::size_t>(word, 0, 1e6));
          if (values.empty()) throw invalid_input_error("'" + v + "' lists no value");
          c.globe.seif_active = values;
        }},
       {"globe", "covariance_period", "10", "NEES of the pose every this many steps (a SEIF's covariance costs a factorization)",
        [](RunnerConfig& c, const std::string& v) { c.globe.covariance_period = parse_integer<std::size_t>(v, 1); }},
       {"globe", "graph_updates", "10", "GraphSLAM global updates after the windowed initialization (thesis Table 10: 10)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = parse_integer<int>(v, 1); }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = parse_integer<int>(v, 1, 1e4); }},
       {"vislam", "velocity_sigma", "0.5", "m/s: IMU linear velocity noise per axis (.npz data)",
        [](RunnerConfig& c, const std::string& v) { c.vislam.velocity_sigma = positive(parse_number(v), v); }},
       {"vislam", "rate_sigma", "0.05", "rad/s: IMU angular velocity noise per axis (.npz data)",
@@ -218,28 +224,28 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"vislam", "min_disparity", "2", "px: smallest disparity a new landmark is triangulated from (.npz data)",
        [](RunnerConfig& c, const std::string& v) { c.vislam.min_disparity = non_negative(parse_number(v), v); }},
       {"vislam", "max_landmarks", "150", "landmark pool capacity (EKF: <= 10 ms per frame on 03.npz)",
-       [](RunnerConfig& c, const std::string& v) { c.vislam.pool.max_landmarks = parse_integer<std::size_t>(v, 1); }},
+       [](RunnerConfig& c, const std::string& v) { c.vislam.pool.max_landmarks = parse_integer<std::size_t>(v, 1, 1e6); }},
       {"vislam", "max_new_per_step", "20", "new landmarks per frame at most",
-       [](RunnerConfig& c, const std::string& v) { c.vislam.pool.max_new_per_step = parse_integer<std::size_t>(v, 1); }},
+       [](RunnerConfig& c, const std::string& v) { c.vislam.pool.max_new_per_step = parse_integer<std::size_t>(v, 1, 1e6); }},
       {"vislam", "gate_probability", "0.999", "Mahalanobis gate of the filters (0 = off)",
        [](RunnerConfig& c, const std::string& v) { c.vislam.gate_probability = parse_gate_probability(v); }},
       {"vislam", "seed", "1", "simulation seed of stereo-vi",
        [](RunnerConfig& c, const std::string& v) { c.vislam.seed = parse_integer<std::uint64_t>(v, 0); }},
       {"vislam", "steps", "400", "stereo-vi frames (one loop)",
-       [](RunnerConfig& c, const std::string& v) { c.vislam.steps = parse_integer<int>(v, 1); }},
+       [](RunnerConfig& c, const std::string& v) { c.vislam.steps = parse_integer<int>(v, 1, 1e6); }},
       {"rawlog", "std_range", "0", "range noise, m; 0 = as stated in the rawlog",
        [](RunnerConfig& c, const std::string& v) {
-         const double x = parse_number(v);
+         const double x = non_negative(parse_number(v), v);
          c.rawlog.std_range = x > 0.0 ? std::optional<double>(x) : std::nullopt;
        }},
       {"rawlog", "std_yaw_deg", "0", "bearing (yaw) noise, degrees; 0 = as stated in the rawlog",
        [](RunnerConfig& c, const std::string& v) {
-         const double x = parse_number(v);
+         const double x = non_negative(parse_number(v), v);
          c.rawlog.std_yaw = x > 0.0 ? std::optional<double>(x * deg) : std::nullopt;
        }},
       {"rawlog", "std_pitch_deg", "0", "pitch noise (3D), degrees; 0 = as stated in the rawlog",
        [](RunnerConfig& c, const std::string& v) {
-         const double x = parse_number(v);
+         const double x = non_negative(parse_number(v), v);
          c.rawlog.std_pitch = x > 0.0 ? std::optional<double>(x * deg) : std::nullopt;
        }},
       {"rawlog", "odometry_std_xy", "0.1", "observation-only rawlogs: odometry noise per step along x and y, m",
@@ -313,14 +319,14 @@ inline const std::vector<ConfigKey>& config_keys() {
        "Mahalanobis gate with the exact marginals (one factorization per update); 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.seif.gate_probability = parse_gate_probability(v); }},
       {"seif", "max_active", "8", "landmarks kept linked to the robot by sparsification; 0 = no sparsification",
-       [](RunnerConfig& c, const std::string& v) { c.seif.max_active = parse_integer<std::size_t>(v, 0); }},
+       [](RunnerConfig& c, const std::string& v) { c.seif.max_active = parse_integer<std::size_t>(v, 0, 1e6); }},
       {"seif", "mean_recovery", "active_block", "active_block (joint solve) | coordinate_descent (thesis)",
        [](RunnerConfig& c, const std::string& v) {
          c.seif.mean_recovery = parse_choice<MeanRecovery>(
              v, {{"active_block", MeanRecovery::active_block}, {"coordinate_descent", MeanRecovery::coordinate_descent}});
        }},
       {"seif", "mean_recovery_sweeps", "1", "recovery sweeps per update",
-       [](RunnerConfig& c, const std::string& v) { c.seif.mean_recovery_sweeps = parse_integer<int>(v, 0); }},
+       [](RunnerConfig& c, const std::string& v) { c.seif.mean_recovery_sweeps = parse_integer<int>(v, 0, 1e4); }},
       {"seif", "exact_recovery_period", "0", "every K updates an exact solve of the whole mean; 0 = never",
        [](RunnerConfig& c, const std::string& v) { c.seif.exact_recovery_period = parse_integer<int>(v, 0); }},
       {"graph", "robust_kernel", "none", "none | huber | cauchy, on measurement factors",
@@ -331,7 +337,7 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"graph", "kernel_width", "2.4477", "robust kernel width, standard deviations of the whitened residual",
        [](RunnerConfig& c, const std::string& v) { c.graph.measurement_loss.width = positive(parse_number(v), v); }},
       {"graph", "max_iterations", "10", "Gauss-Newton iterations at most",
-       [](RunnerConfig& c, const std::string& v) { c.graph.max_iterations = parse_integer<int>(v, 1); }},
+       [](RunnerConfig& c, const std::string& v) { c.graph.max_iterations = parse_integer<int>(v, 1, 1e6); }},
       {"graph", "solver", "automatic", "automatic | landmark_schur (thesis) | full (sparse Cholesky of everything)",
        [](RunnerConfig& c, const std::string& v) {
          c.graph.solver = parse_choice<GraphSolver>(v, {{"automatic", GraphSolver::automatic},
@@ -345,7 +351,7 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"fastslam", "gate_probability", "0", "per-particle Mahalanobis gate on known landmarks; 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.fastslam.gate_probability = parse_gate_probability(v); }},
       {"fastslam", "particles", "100", "particles",
-       [](RunnerConfig& c, const std::string& v) { c.fastslam.particles = parse_integer<std::size_t>(v, 1); }},
+       [](RunnerConfig& c, const std::string& v) { c.fastslam.particles = parse_integer<std::size_t>(v, 1, 1e6); }},
       {"fastslam", "resample_threshold", "0.1", "resample when N_eff < threshold * particles (1 = always, 0 = never)",
        [](RunnerConfig& c, const std::string& v) {
          const double t = parse_number(v);
@@ -379,12 +385,69 @@ inline std::string documented_defaults() {
   return out.str();
 }
 
-/// The defaults, overridden by the file's keys; throws invalid_input_error "file: [section] key: problem".
+namespace detail {
+
+/// Up to 40 characters of `text` with every byte that is not printable ASCII shown as \xHH, so that
+/// a message never echoes raw bytes.
+inline std::string printable_excerpt(const std::string& text, std::size_t length = 40) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size() && i < length; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      out += hex;
+    }
+  }
+  return text.size() > length ? out + "..." : out;
+}
+
+/// Reads the ini file line by line before MRPT's parser sees it, and throws "file:line: problem"
+/// for what that parser would pass over in silence: a file it cannot read, bytes that are not text,
+/// a line that is neither a comment, a [section], an MRPT directive (@...) nor key = value, a key
+/// before any section, a key given twice in one section.
+inline void lint_ini_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw invalid_input_error(path + ": cannot read the config file (" + std::strerror(errno) + ")");
+  std::map<std::string, int> first_line;  // "[section] key" -> line
+  std::string section, line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    const std::string where = path + ":" + std::to_string(number) + ": ";
+    for (unsigned char c : line)
+      if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7f)
+        throw invalid_input_error(where + "not a text line: '" + printable_excerpt(line) + "'");
+    const std::string text = without_comment(line);
+    if (text.empty() || text[0] == '#' || text[0] == ';' || text[0] == '@') continue;
+    if (text.front() == '[') {
+      if (text.back() != ']') throw invalid_input_error(where + "a section header without ']': '" + printable_excerpt(text) + "'");
+      section = text.substr(1, text.size() - 2);
+      continue;
+    }
+    const auto equals = text.find('=');
+    if (equals == std::string::npos || equals == 0)
+      throw invalid_input_error(where + "neither [section] nor key = value: '" + printable_excerpt(text) + "'");
+    const std::string key = without_comment(text.substr(0, equals));
+    if (section.empty()) throw invalid_input_error(where + key + ": a key before any [section]");
+    const auto [it, fresh] = first_line.emplace("[" + section + "] " + key, number);
+    if (!fresh)
+      throw invalid_input_error(where + "[" + section + "] " + key + ": given twice (first at line " +
+                                std::to_string(it->second) + ")");
+  }
+  if (in.bad()) throw invalid_input_error(path + ": cannot read the config file");
+}
+
+}  // namespace detail
+
+/// The defaults, overridden by the file's keys; throws invalid_input_error "file: [section] key: problem"
+/// (or "file:line: problem" for a line that is not a setting, detail::lint_ini_file).
 inline RunnerConfig load_config(const std::string& path) {
   RunnerConfig config;
   for (const auto& k : config_keys()) k.apply(config, k.default_value);
   if (path.empty()) return config;
-  if (!std::filesystem::is_regular_file(path)) throw invalid_input_error(path + ": cannot open config file");
+  if (!std::filesystem::is_regular_file(path)) throw invalid_input_error(path + ": cannot open config file (not a file)");
+  detail::lint_ini_file(path);
   // MRPT's parser throws its own exceptions on what it cannot expand ("$env{" without its "}", a
   // broken "$eval{...}"): a file we cannot read is an invalid_input_error like any other.
   std::optional<::mrpt::config::CConfigFile> parsed;
@@ -393,7 +456,8 @@ inline RunnerConfig load_config(const std::string& path) {
     parsed.emplace(path);
     parsed->getAllSections(sections);
   } catch (const std::exception& e) {
-    throw invalid_input_error(path + ": not a readable ini file (" + mrpt_io::exception_message(e.what()) + ")");
+    throw invalid_input_error(path + ": not a readable ini file (" +
+                              detail::printable_excerpt(mrpt_io::exception_message(e.what()), 300) + ")");
   }
   auto& file = *parsed;
   for (const auto& section : sections) {
@@ -407,7 +471,7 @@ inline RunnerConfig load_config(const std::string& path) {
       try {
         it->apply(config, detail::without_comment(file.read_string(section, name, "", true)));
       } catch (const std::exception& e) {
-        throw invalid_input_error(where + ": " + e.what());
+        throw invalid_input_error(where + ": " + detail::printable_excerpt(e.what(), 300));
       }
     }
   }

@@ -1,6 +1,7 @@
 #include "sextant/io/mrclam_reader.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <fstream>
 #include <numbers>
@@ -95,6 +96,42 @@ TEST_F(MrclamFiles, MalformedFilesNameFileAndLine) {
   EXPECT_NE(message().find("Barcodes.dat: cannot open file"), std::string::npos) << message();
   EXPECT_THROW(read_mrclam(dir_.string(), 7), parse_error);
   EXPECT_THROW(read_mrclam(dir_.string(), 1, {.max_step = 0.0}), invalid_input_error);
+}
+
+TEST_F(MrclamFiles, ImplausibleTimeSpansAndRunsWithoutMeasurementsAreRefusedBeforeAnyStepIsMade) {
+  // Issue 36: odometry and Vicon rows 1e7 s after the rest made the step splitter run for 110 s at
+  // 16.6 GB and exit 0; measurements all outside the run gave a table of zeros.
+  const auto message = [&](const MrclamOptions& options) {
+    try {
+      read_mrclam(dir_.string(), 1, options);
+    } catch (const parse_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  write("Robot1_Odometry.dat", "# t v w\n100.0 1.0 0.0\n100.5 1.0 0.0\n101.0 0.5 0.2\n1e7 0.0 0.0\n");
+  EXPECT_NE(message({}).find("Robot1_Odometry.dat:5: 9999899.000000 s after the previous row, more than 60.000000 s "
+                             "(MrclamOptions::max_gap)"),
+            std::string::npos)
+      << message({});
+  write("Robot1_Odometry.dat", "# t v w\n100.0 1.0 0.0\n103.0 0.0 0.0\n");
+  write("Robot1_Groundtruth.dat", "# t x y h\n99.0 0.0 0.0 3.0\n101.0 2.0 0.0 -3.0\n5e6 5.0 0.0 -3.0\n");
+  EXPECT_NE(message({}).find("Robot1_Groundtruth.dat:4:"), std::string::npos) << message({});
+  rusage usage{};
+  ::getrusage(RUSAGE_SELF, &usage);
+  EXPECT_LT(usage.ru_maxrss, 200 * 1024) << "peak RSS in kB";
+
+  // Within the gaps, more steps than the limit: refused by counting, before they are made.
+  write("Robot1_Groundtruth.dat", "# t x y h\n99.0 0.0 0.0 3.0\n101.0 2.0 0.0 -3.0\n104.0 5.0 0.0 -3.0\n");
+  EXPECT_NE(message({.max_step = 0.5, .max_steps = 5}).find("would be 7 steps, more than 5 (MrclamOptions::max_steps)"),
+            std::string::npos)
+      << message({.max_step = 0.5, .max_steps = 5});
+  EXPECT_EQ(message({.max_step = 0.5, .max_steps = 7}), "no error");
+
+  write("Robot1_Measurement.dat", "# t barcode r b\n99.5 63 1.0 0.0\n200.0 81 1.0 0.0\n");
+  EXPECT_NE(message({}).find("no landmark measurement inside the odometry and Vicon time span (2 outside it"),
+            std::string::npos)
+      << message({});
 }
 
 /// Every measurement row of the real files ends up used or in exactly one drop count.

@@ -1,11 +1,13 @@
 #include "sextant/io/visual_inertial_npz.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <zip.h>
 
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <algorithm>
 #include <map>
 
@@ -54,8 +56,10 @@ class NpzFiles : public ::testing::Test {
   void SetUp() override { std::filesystem::create_directories(dir); }
   void TearDown() override { std::filesystem::remove_all(dir); }
 
-  /// Writes a .npz of the given entries (key -> .npy bytes), stored without compression.
-  std::string write_npz(const std::string& name, const std::map<std::string, std::string>& entries) {
+  /// Writes a .npz of the given entries (key -> .npy bytes), stored without compression (deflated
+  /// with `method` ZIP_CM_DEFLATE).
+  std::string write_npz(const std::string& name, const std::map<std::string, std::string>& entries,
+                        zip_int32_t method = ZIP_CM_STORE) {
     const auto path = (dir / name).string();
     int error = 0;
     zip_t* archive = zip_open(path.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &error);
@@ -64,7 +68,7 @@ class NpzFiles : public ::testing::Test {
       zip_source_t* source = zip_source_buffer(archive, bytes.data(), bytes.size(), 0);
       const auto index = zip_file_add(archive, (key + ".npy").c_str(), source, ZIP_FL_OVERWRITE);
       EXPECT_GE(index, 0);
-      zip_set_file_compression(archive, static_cast<zip_uint64_t>(index), ZIP_CM_STORE, 0);
+      zip_set_file_compression(archive, static_cast<zip_uint64_t>(index), method, 0);
     }
     EXPECT_EQ(zip_close(archive), 0);  // the buffers must live until here
     return path;
@@ -101,6 +105,44 @@ class NpzFiles : public ::testing::Test {
     return {};
   }
 };
+
+/// Sets the uncompressed size the archive states for `entry` (local and central header alike, so
+/// that libzip's consistency check passes): an entry that would inflate to `size` bytes.
+void state_uncompressed_size(const std::string& path, const std::string& entry, std::uint32_t size) {
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  auto put = [&](std::size_t at) {
+    for (int b = 0; b < 4; ++b) bytes[at + b] = static_cast<char>((size >> (8 * b)) & 0xff);
+  };
+  int patched = 0;
+  for (std::size_t at = bytes.find("PK\x03\x04"); at != std::string::npos; at = bytes.find("PK\x03\x04", at + 4))
+    if (bytes.compare(at + 30, entry.size(), entry) == 0) put(at + 22), ++patched;
+  for (std::size_t at = bytes.find("PK\x01\x02"); at != std::string::npos; at = bytes.find("PK\x01\x02", at + 4))
+    if (bytes.compare(at + 46, entry.size(), entry) == 0) put(at + 24), ++patched;
+  ASSERT_EQ(patched, 2) << "local and central header of " << entry;
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+TEST_F(NpzFiles, AnEntryBeyondTheSizeLimitIsRefusedBeforeAByteIsInflated) {
+  // Issue 36: a 5.6 MB .npz whose features.npy deflates to 3.8 GB was inflated whole (peak RSS
+  // 3.8 GB), one of 12.8 GB ended in std::bad_alloc naming no file. The archive states each entry's
+  // uncompressed size, and libzip never inflates past it: that statement is checked first.
+  auto entries = small_dataset();
+  entries["features"] = npy(std::vector<double>(4 * 2 * 3, -1.0), "(4, 59375000, 2)");  // 3.8 GB declared
+  const auto path = write_npz("bomb.npz", entries, ZIP_CM_DEFLATE);
+  state_uncompressed_size(path, "features.npy", 3'800'000'000u);
+  const std::string message = error_of(path);
+  EXPECT_NE(message.find(path + ": key 'features': 3800000000 bytes once uncompressed"), std::string::npos) << message;
+  EXPECT_NE(message.find("more than the reader's limit of 1073741824 bytes"), std::string::npos) << message;
+  rusage usage{};
+  ::getrusage(RUSAGE_SELF, &usage);
+  EXPECT_LT(usage.ru_maxrss, 200 * 1024) << "peak RSS in kB";  // the whole test process, this test alone under ctest
+  // An entry of the stated size within the limit reads as before.
+  EXPECT_NO_THROW(NpzFile(write_npz("fine.npz", small_dataset(), ZIP_CM_DEFLATE)).array("features"));
+}
 
 TEST(Npy, ReadsEveryDtypeInCAndFortranOrder) {
   for (const std::string descr : {"<f8", "<f4", "<i8", "<i4"}) {

@@ -2,6 +2,7 @@
 // and bad input (missing, truncated or malformed rawlog, unknown config key or value) ends with a
 // non-zero exit and one line naming the file and the problem.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -227,12 +228,50 @@ TEST_F(RunnerCli, BadConfigEndsWithOneLineNamingFileKeyAndProblem) {
   // Found by the fuzzer: 5.5e81 was converted to long long (undefined behaviour), and values above
   // an int's range were truncated silently.
   std::ofstream(ini) << "[ship]\nruns = 5.5e81\n";
-  expect_one_line_error("-d ship -c " + ini, {ini, "[ship] runs", "is not an integer in [1, 2147483647]"});
+  expect_one_line_error("-d ship -c " + ini, {ini, "[ship] runs", "is not an integer in [1, 100000]"});
 
   const auto missing = (dir / "missing.ini").string();
   expect_one_line_error("-d ship -c " + missing, {missing, "cannot open config file"});
 
   expect_one_line_error("-d ship -b kalman", {"--backend", "unknown back-end 'kalman'"});
+}
+
+TEST_F(RunnerCli, ConfigFilesThatAreNotSettingsAreRefused) {
+  // Issue 36: each of these ran silently with the defaults (or ended in std::bad_alloc naming no key).
+  const auto ini = (dir / "odd.ini").string();
+  auto refused = [&](const std::string& content, const std::vector<std::string>& fragments) {
+    std::ofstream(ini, std::ios::binary | std::ios::trunc) << content;
+    expect_one_line_error("-d ship -c " + ini, fragments);
+  };
+  refused("these are words\nand more words\n", {ini + ":1:", "neither [section] nor key = value", "'these are words'"});
+  refused("max_active = 3\n[seif]\n", {ini + ":1:", "max_active: a key before any [section]"});
+  refused("[ekf]\nbatch_update = true\n\nbatch_update = false\n", {ini + ":4:", "[ekf] batch_update: given twice (first at line 2)"});
+  refused("[ekf\nbatch_update = true\n", {ini + ":1:", "a section header without ']'"});
+  refused("[rawlog]\nstd_range = -1\n", {ini, "[rawlog] std_range", "must be >= 0"});
+  refused("[rawlog]\nstd_yaw_deg = -2\n", {ini, "[rawlog] std_yaw_deg", "must be >= 0"});
+  refused("[rawlog]\nstd_pitch_deg = -0.05\n", {ini, "[rawlog] std_pitch_deg", "must be >= 0"});
+  refused("[fastslam]\nparticles = 2000000000\n", {ini, "[fastslam] particles", "is not an integer in [1, 1000000]"});
+  refused("[ship]\nsteps = 2000000000\n", {ini, "[ship] steps", "is not an integer in [1, 10000000]"});
+  refused("[globe]\nseif_active = 150 2000000000\n", {ini, "[globe] seif_active", "is not an integer in [0, 1000000]"});
+
+  // Random bytes: refused, and the message shows no raw byte.
+  std::string bytes = "[ship]\nseed = 1\n";
+  for (int i = 0; i < 64; ++i) bytes += static_cast<char>((i * 37 + 11) % 256);
+  std::ofstream(ini, std::ios::binary | std::ios::trunc) << bytes;
+  const auto r = run_runner("-d ship -c " + ini, dir);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find(ini + ":3: not a text line"), std::string::npos) << r.err;
+  for (std::size_t k = 0; k + 1 < r.err.size(); ++k)
+    EXPECT_TRUE(r.err[k] >= 0x20 && r.err[k] < 0x7f) << "raw byte " << static_cast<int>(static_cast<unsigned char>(r.err[k]))
+                                                    << " at " << k << " in: " << r.err;
+
+  // A file the process cannot read is an error, never the defaults. Root reads any file: there the
+  // permission cannot be taken away, and only the directory case is checked.
+  expect_one_line_error("-d ship -c " + dir.string(), {dir.string(), "cannot open config file"});
+  std::ofstream(ini, std::ios::trunc) << "[ship]\nruns = 1\n";
+  fs::permissions(ini, fs::perms::none);
+  if (::access(ini.c_str(), R_OK) != 0) expect_one_line_error("-d ship -c " + ini, {ini, "cannot read the config file"});
+  fs::permissions(ini, fs::perms::owner_read | fs::perms::owner_write);
 }
 
 TEST_F(RunnerCli, ConfigReferenceInDocsIsThePrintedDefaults) {

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
@@ -44,6 +45,14 @@ struct MrclamOptions {
   /// [s] added to every odometry time stamp: the robot moves as commanded this long after the
   /// stamp (Dataset6: odometry w best matches Vicon's yaw rate 0.2 s later, docs/results/mrclam.md).
   double odometry_delay = 0.0;
+  /// [s] the longest gap allowed between two odometry or two Vicon rows (Dataset6: at most 1.03 and
+  /// 2.03 s; landmark measurements may pause for minutes). A longer one is an error naming the row:
+  /// the steps across it would have no control, and a stray time stamp would cut the run into
+  /// millions of steps.
+  double max_gap = 60.0;
+  /// The most steps a run may be cut into (10^6 steps of 0.25 s are 69 hours; Dataset6's robots
+  /// have about 27000); more is an error before any step is made.
+  std::size_t max_steps = 1'000'000;
 };
 
 struct MrclamCounts {
@@ -72,7 +81,10 @@ struct TimedRow {
 };
 
 /// Rows of `columns` values with a time in the first, in non-decreasing time order.
-inline std::vector<TimedRow> read_timed_rows(const std::string& path, std::size_t columns, const char* layout) {
+/// The rows of a file of time-stamped rows, times non-decreasing and (max_gap) no two rows further
+/// apart than max_gap seconds.
+inline std::vector<TimedRow> read_timed_rows(const std::string& path, std::size_t columns, const char* layout,
+                                             double max_gap = std::numeric_limits<double>::infinity()) {
   std::vector<TimedRow> out;
   for (auto& [line, values] : read_numeric_rows(path)) {
     const std::string where = path + ":" + std::to_string(line);
@@ -81,6 +93,9 @@ inline std::vector<TimedRow> read_timed_rows(const std::string& path, std::size_
                         std::to_string(values.size()));
     if (!out.empty() && values[0] < out.back().t)
       throw parse_error(where + ": time " + std::to_string(values[0]) + " is before the previous row's");
+    if (!out.empty() && values[0] - out.back().t > max_gap)
+      throw parse_error(where + ": " + std::to_string(values[0] - out.back().t) + " s after the previous row, more than " +
+                        std::to_string(max_gap) + " s (MrclamOptions::max_gap)");
     out.push_back({values[0], std::move(values), line});
   }
   if (out.empty()) throw parse_error(path + ": no data rows");
@@ -124,40 +139,117 @@ inline UnicycleControl mean_velocity(const std::vector<TimedRow>& odometry, std:
 
 }  // namespace detail
 
-/// Reads robot `robot` (1-based) of the MRCLAM data set in `directory`.
-inline MrclamRun read_mrclam(const std::string& directory, int robot, const MrclamOptions& options = {}) {
+namespace detail {
+
+inline void require_valid(const MrclamOptions& options) {
   if (!(options.max_step > 0.0) || !std::isfinite(options.max_step))
     throw invalid_input_error("MRCLAM: max_step must be a positive number of seconds");
   if (!(options.measurement_sigma.array() > 0.0).all() || !(options.prior_sigma.array() > 0.0).all() ||
       !options.measurement_sigma.allFinite() || !options.prior_sigma.allFinite())
     throw invalid_input_error("MRCLAM: measurement and prior standard deviations must be positive and finite");
+  if (!(options.max_gap > 0.0)) throw invalid_input_error("MRCLAM: max_gap must be a positive number of seconds");
+}
+
+/// Barcodes.dat: subject of each barcode.
+inline std::map<LandmarkId, LandmarkId> read_barcodes(const std::string& path) {
+  std::map<LandmarkId, LandmarkId> subject_of_barcode;
+  for (const auto& [line, values] : read_numeric_rows(path)) {
+    const std::string where = path + ":" + std::to_string(line);
+    if (values.size() != 2) throw parse_error(where + ": expected 2 values (subject barcode)");
+    if (!subject_of_barcode.emplace(subject_id(values[1], where), subject_id(values[0], where)).second)
+      throw parse_error(where + ": barcode listed twice");
+  }
+  return subject_of_barcode;
+}
+
+/// Landmark_Groundtruth.dat: each landmark subject's position.
+inline std::map<LandmarkId, Eigen::Vector2d> read_landmarks(const std::string& path) {
+  std::map<LandmarkId, Eigen::Vector2d> landmarks;
+  for (const auto& [line, values] : read_numeric_rows(path)) {
+    const std::string where = path + ":" + std::to_string(line);
+    if (values.size() != 5) throw parse_error(where + ": expected 5 values (subject x y sx sy)");
+    if (!landmarks.emplace(subject_id(values[0], where), Eigen::Vector2d(values[1], values[2])).second)
+      throw parse_error(where + ": landmark listed twice");
+  }
+  return landmarks;
+}
+
+/// Where the steps end: at every measurement time inside (start, end], then split so that no step
+/// is longer than max_step. Throws before making them when they would be more than max_steps.
+inline std::vector<double> step_ends(const std::vector<TimedRow>& measurements, double start, double end,
+                                     const MrclamOptions& options, const std::string& run) {
+  std::vector<double> stops;
+  for (const auto& row : measurements)
+    if (row.t > start && row.t <= end && (stops.empty() || row.t > stops.back())) stops.push_back(row.t);
+  if (stops.empty() || stops.back() < end) stops.push_back(end);
+  double count = 0.0, t = start;
+  for (const double stop : stops) count += std::max(1.0, std::ceil((stop - t) / options.max_step - 1e-9)), t = stop;
+  if (count > static_cast<double>(options.max_steps))
+    throw parse_error(run + ": " + std::to_string(end - start) + " s cut into steps of at most " +
+                      std::to_string(options.max_step) + " s would be " + std::to_string(static_cast<long long>(count)) +
+                      " steps, more than " + std::to_string(options.max_steps) + " (MrclamOptions::max_steps)");
+  std::vector<double> ends;
+  t = start;
+  for (const double stop : stops) {
+    const int pieces = std::max(1, static_cast<int>(std::ceil((stop - t) / options.max_step - 1e-9)));
+    const double length = (stop - t) / pieces;
+    for (int piece = 1; piece <= pieces; ++piece) ends.push_back(piece == pieces ? stop : t + length), t = ends.back();
+  }
+  return ends;
+}
+
+/// The measurements up to time `stop` (from `next` on) into the last step: landmark sightings
+/// become observations; the others are counted (before the run, unknown barcodes, other robots,
+/// a landmark twice at one time).
+inline void add_measurements(MrclamRun& run, const std::vector<TimedRow>& measurements, std::size_t& next,
+                             const std::map<LandmarkId, LandmarkId>& subject_of_barcode, double start, double stop,
+                             const MrclamOptions& options, const std::string& path) {
+  std::set<LandmarkId> seen;
+  for (; next < measurements.size() && measurements[next].t <= stop; ++next) {
+    const auto& row = measurements[next];
+    const std::string where = path + ":" + std::to_string(row.line);
+    if (row.t <= start) {
+      ++run.counts.outside_run;
+      continue;
+    }
+    const auto barcode = subject_of_barcode.find(subject_id(row.values[1], where));
+    if (barcode == subject_of_barcode.end()) {
+      ++run.counts.unknown_barcodes;
+    } else if (barcode->second <= static_cast<LandmarkId>(options.robot_subjects)) {
+      ++run.counts.robot_sightings;
+    } else if (!run.true_landmarks.contains(barcode->second)) {
+      ++run.counts.unknown_barcodes;
+    } else if (!seen.insert(barcode->second).second) {
+      ++run.counts.repeated_in_step;
+    } else {
+      if (!(row.values[2] > 0.0)) throw parse_error(where + ": range must be positive");
+      run.steps.back().observations.push_back({barcode->second, Eigen::Vector2d(row.values[2], row.values[3])});
+      ++run.counts.measurements;
+    }
+  }
+}
+
+}  // namespace detail
+
+/// Reads robot `robot` (1-based) of the MRCLAM data set in `directory`.
+inline MrclamRun read_mrclam(const std::string& directory, int robot, const MrclamOptions& options = {}) {
+  detail::require_valid(options);
   const std::filesystem::path dir(directory);
   const std::string prefix = "Robot" + std::to_string(robot) + "_";
   const auto file = [&](const std::string& name) { return (dir / name).string(); };
-  if (!std::filesystem::exists(file(prefix + "Odometry.dat")))
+  if (!std::filesystem::is_regular_file(file(prefix + "Odometry.dat")))
     throw parse_error(file(prefix + "Odometry.dat") + ": cannot open file (robot " + std::to_string(robot) +
                       " of an MRCLAM data set?)");
-
-  std::map<LandmarkId, LandmarkId> subject_of_barcode;
-  for (const auto& [line, values] : detail::read_numeric_rows(file("Barcodes.dat"))) {
-    const std::string where = file("Barcodes.dat") + ":" + std::to_string(line);
-    if (values.size() != 2) throw parse_error(where + ": expected 2 values (subject barcode)");
-    if (!subject_of_barcode.emplace(detail::subject_id(values[1], where), detail::subject_id(values[0], where)).second)
-      throw parse_error(where + ": barcode listed twice");
-  }
+  const auto subject_of_barcode = detail::read_barcodes(file("Barcodes.dat"));
   MrclamRun run;
   run.path = directory + " robot " + std::to_string(robot);
   run.motion = options.motion;
   run.sensor.Q = options.measurement_sigma.cwiseAbs2().asDiagonal();
-  for (const auto& [line, values] : detail::read_numeric_rows(file("Landmark_Groundtruth.dat"))) {
-    const std::string where = file("Landmark_Groundtruth.dat") + ":" + std::to_string(line);
-    if (values.size() != 5) throw parse_error(where + ": expected 5 values (subject x y sx sy)");
-    if (!run.true_landmarks.emplace(detail::subject_id(values[0], where), Eigen::Vector2d(values[1], values[2])).second)
-      throw parse_error(where + ": landmark listed twice");
-  }
-  auto odometry = detail::read_timed_rows(file(prefix + "Odometry.dat"), 3, "t v w");
+  for (const auto& [subject, position] : detail::read_landmarks(file("Landmark_Groundtruth.dat")))
+    run.true_landmarks.emplace(subject, position);
+  auto odometry = detail::read_timed_rows(file(prefix + "Odometry.dat"), 3, "t v w", options.max_gap);
   for (auto& row : odometry) row.t += options.odometry_delay;
-  const auto truth = detail::read_timed_rows(file(prefix + "Groundtruth.dat"), 4, "t x y heading");
+  const auto truth = detail::read_timed_rows(file(prefix + "Groundtruth.dat"), 4, "t x y heading", options.max_gap);
   const auto measurements = detail::read_timed_rows(file(prefix + "Measurement.dat"), 4, "t barcode range bearing");
 
   const double start = std::max(odometry.front().t, truth.front().t);
@@ -168,51 +260,24 @@ inline MrclamRun read_mrclam(const std::string& directory, int robot, const Mrcl
   run.prior.cov = options.prior_sigma.cwiseAbs2().asDiagonal();
   run.true_poses.push_back(run.prior.mean);
   run.counts.odometry_samples = odometry.size();
-
-  // Step ends: every measurement time inside the run, then filled so no step exceeds max_step.
-  std::vector<double> ends;
-  for (const auto& row : measurements)
-    if (row.t > start && row.t <= end && (ends.empty() || row.t > ends.back())) ends.push_back(row.t);
-  if (ends.empty() || ends.back() < end) ends.push_back(end);
   std::size_t next = 1;
   while (next < odometry.size() && odometry[next].t <= start) ++next;
   std::size_t measurement = 0;
   double t = start;
-  for (const double stop : ends) {
-    const int pieces = std::max(1, static_cast<int>(std::ceil((stop - t) / options.max_step - 1e-9)));
-    const double length = (stop - t) / pieces;
-    for (int piece = 1; piece <= pieces; ++piece) {
-      const double b = piece == pieces ? stop : t + length;
-      run.steps.push_back({detail::mean_velocity(odometry, next, t, b), b - t, {}});
-      run.step_times.push_back(b - start);
-      t = b;
-      run.true_poses.push_back(detail::interpolate_pose(truth, b));
-    }
-    std::set<LandmarkId> seen;
-    for (; measurement < measurements.size() && measurements[measurement].t <= stop; ++measurement) {
-      const auto& row = measurements[measurement];
-      const std::string where = file(prefix + "Measurement.dat") + ":" + std::to_string(row.line);
-      if (row.t <= start) {
-        ++run.counts.outside_run;
-        continue;
-      }
-      const auto barcode = subject_of_barcode.find(detail::subject_id(row.values[1], where));
-      if (barcode == subject_of_barcode.end()) {
-        ++run.counts.unknown_barcodes;
-      } else if (barcode->second <= static_cast<LandmarkId>(options.robot_subjects)) {
-        ++run.counts.robot_sightings;
-      } else if (!run.true_landmarks.contains(barcode->second)) {
-        ++run.counts.unknown_barcodes;
-      } else if (!seen.insert(barcode->second).second) {
-        ++run.counts.repeated_in_step;
-      } else {
-        if (!(row.values[2] > 0.0)) throw parse_error(where + ": range must be positive");
-        run.steps.back().observations.push_back({barcode->second, Eigen::Vector2d(row.values[2], row.values[3])});
-        ++run.counts.measurements;
-      }
-    }
+  for (const double b : detail::step_ends(measurements, start, end, options, run.path)) {
+    run.steps.push_back({detail::mean_velocity(odometry, next, t, b), b - t, {}});
+    run.step_times.push_back(b - start);
+    run.true_poses.push_back(detail::interpolate_pose(truth, b));
+    t = b;
+    detail::add_measurements(run, measurements, measurement, subject_of_barcode, start, b, options,
+                             file(prefix + "Measurement.dat"));
   }
   run.counts.outside_run += measurements.size() - measurement;
+  if (run.counts.measurements == 0)
+    throw parse_error(run.path + ": no landmark measurement inside the odometry and Vicon time span (" +
+                      std::to_string(run.counts.outside_run) + " outside it, " +
+                      std::to_string(run.counts.unknown_barcodes) + " of unknown barcodes, " +
+                      std::to_string(run.counts.robot_sightings) + " of robots)");
   return run;
 }
 

@@ -17,9 +17,16 @@ namespace sextant::io {
 
 class NpzFile {
  public:
+  /// The largest entry array() inflates, in bytes once uncompressed (1 GiB). An entry compresses
+  /// far better than that can be checked from the archive's size (a sparse feature array of the
+  /// KITTI-derived files is 165 MB deflated to 1.5 MB, 100:1), so the archive's own statement of the
+  /// uncompressed size is checked against this limit before a byte is inflated.
+  static constexpr std::size_t kDefaultMaxEntryBytes = std::size_t{1} << 30;
+
   /// Opens `path`; libzip checks the archive's central directory against the file (ZIP_CHECKCONS),
   /// so a truncated file fails here.
-  explicit NpzFile(std::string path) : path_(std::move(path)) {
+  explicit NpzFile(std::string path, std::size_t max_entry_bytes = kDefaultMaxEntryBytes)
+      : path_(std::move(path)), max_entry_bytes_(max_entry_bytes) {
     int error_code = 0;
     zip_t* archive = zip_open(path_.c_str(), ZIP_RDONLY | ZIP_CHECKCONS, &error_code);
     if (!archive) {
@@ -58,6 +65,10 @@ class NpzFile {
     zip_stat_init(&stat);
     if (zip_stat_index(archive_.get(), static_cast<zip_uint64_t>(index), 0, &stat) != 0 || !(stat.valid & ZIP_STAT_SIZE))
       throw parse_error(what + ": the entry's size is unknown: " + zip_strerror(archive_.get()));
+    if (stat.size > max_entry_bytes_)
+      throw parse_error(what + ": " + std::to_string(stat.size) + " bytes once uncompressed (" +
+                        std::to_string(stat.comp_size) + " compressed), more than the reader's limit of " +
+                        std::to_string(max_entry_bytes_) + " bytes (NpzFile::kDefaultMaxEntryBytes)");
     std::unique_ptr<zip_file_t, ZipFileCloser> file(zip_fopen_index(archive_.get(), static_cast<zip_uint64_t>(index), 0));
     if (!file) throw parse_error(what + ": cannot open the entry: " + zip_strerror(archive_.get()));
     bool failed = false;
@@ -99,6 +110,7 @@ class NpzFile {
   };
   std::string path_;
   std::unique_ptr<zip_t, ZipCloser> archive_;
+  std::size_t max_entry_bytes_;
 };
 
 }  // namespace sextant::io

@@ -104,47 +104,42 @@ inline double read_scalar(const NpzFile& file, const std::string& key) {
   return require_shape(a, a.shape, what).values[0];
 }
 
-}  // namespace detail
-
-inline VisualInertialDataset read_visual_inertial_npz(const std::string& path, const VisualInertialNpzOptions& options = {}) {
-  const NpzFile file(path);
-  const auto what = [&](const std::string& key) { return path + ": key '" + key + "'"; };
-  VisualInertialDataset data;
-  data.path = path;
-
+/// time_stamps: shape (1, T) or (T,), strictly increasing.
+inline std::vector<double> read_time_stamps(const NpzFile& file) {
+  const std::string what = file.path() + ": key 'time_stamps'";
   const auto stamps = file.array("time_stamps");
   if (stamps.values.empty() || stamps.shape.empty() || (stamps.shape.size() == 2 && stamps.shape[0] != 1) || stamps.shape.size() > 2)
-    throw parse_error(what("time_stamps") + ": expected shape (1, T) or (T,)");
-  detail::require_shape(stamps, stamps.shape, what("time_stamps"));
-  const std::size_t T = stamps.values.size();
-  data.time_stamps = stamps.values;
-  for (std::size_t k = 1; k < T; ++k)
-    if (!(data.time_stamps[k] > data.time_stamps[k - 1]))
-      throw parse_error(what("time_stamps") + ": frame " + std::to_string(k) + " is not later than frame " +
-                        std::to_string(k - 1) + " (dt <= 0)");
+    throw parse_error(what + ": expected shape (1, T) or (T,)");
+  require_shape(stamps, stamps.shape, what);
+  for (std::size_t k = 1; k < stamps.values.size(); ++k)
+    if (!(stamps.values[k] > stamps.values[k - 1]))
+      throw parse_error(what + ": frame " + std::to_string(k) + " is not later than frame " + std::to_string(k - 1) +
+                        " (dt <= 0)");
+  return stamps.values;
+}
 
-  const std::string angular_key = file.contains("angular_velocity") ? "angular_velocity" : "rotational_velocity";
-  if (!file.contains(angular_key)) throw parse_error(what("angular_velocity") + " (or 'rotational_velocity') is missing");
-  const auto v = file.array("linear_velocity"), w = file.array(angular_key);
-  detail::require_shape(v, {3, T}, what("linear_velocity"));
-  detail::require_shape(w, {3, T}, what(angular_key));
-
+/// K and b: the stereo rig's calibration.
+inline StereoCalibration read_calibration(const NpzFile& file) {
+  const std::string what = file.path() + ": key ";
   const auto K = file.array("K");
-  detail::require_shape(K, {3, 3}, what("K"));
-  data.calibration = {.fx = K.values[0], .fy = K.values[4], .cx = K.values[2], .cy = K.values[5],
-                      .baseline = detail::read_scalar(file, "b")};
-  if (!(data.calibration.fx > 0.0 && data.calibration.fy > 0.0))
-    throw parse_error(what("K") + ": focal lengths must be positive");
-  if (!(data.calibration.baseline > 0.0)) throw parse_error(what("b") + ": the baseline must be positive");
-  data.cam_T_imu = detail::read_extrinsic(file, options, data.extrinsic_key);
+  require_shape(K, {3, 3}, what + "'K'");
+  const StereoCalibration calibration{.fx = K.values[0], .fy = K.values[4], .cx = K.values[2], .cy = K.values[5],
+                                      .baseline = read_scalar(file, "b")};
+  if (!(calibration.fx > 0.0 && calibration.fy > 0.0)) throw parse_error(what + "'K': focal lengths must be positive");
+  if (!(calibration.baseline > 0.0)) throw parse_error(what + "'b': the baseline must be positive");
+  return calibration;
+}
 
+/// features (4, M, T): each landmark m's pixels in frame k, -1 where unseen, into one list per
+/// frame; a partly unseen observation is counted and left out.
+inline std::vector<std::vector<Observation<Eigen::Vector4d>>> read_frames(const NpzFile& file, std::size_t T,
+                                                                           VisualInertialDataset& data) {
   const auto features = file.array("features");
   if (features.shape.size() != 3 || features.shape[0] != 4 || features.shape[2] != T)
-    throw parse_error(what("features") + ": expected shape (4, M, " + std::to_string(T) + ")");
-  detail::require_shape(features, features.shape, what("features"));
+    throw parse_error(file.path() + ": key 'features': expected shape (4, M, " + std::to_string(T) + ")");
+  require_shape(features, features.shape, file.path() + ": key 'features'");
   const std::size_t M = features.shape[1];
   data.landmark_count = M;
-
   std::vector<std::vector<Observation<Eigen::Vector4d>>> frames(T);
   for (std::size_t m = 0; m < M; ++m)
     for (std::size_t k = 0; k < T; ++k) {
@@ -162,6 +157,28 @@ inline VisualInertialDataset read_visual_inertial_npz(const std::string& path, c
       frames[k].push_back({static_cast<LandmarkId>(m), z});
       ++data.observation_count;
     }
+  return frames;
+}
+
+}  // namespace detail
+
+inline VisualInertialDataset read_visual_inertial_npz(const std::string& path, const VisualInertialNpzOptions& options = {}) {
+  const NpzFile file(path);
+  const auto what = [&](const std::string& key) { return path + ": key '" + key + "'"; };
+  VisualInertialDataset data;
+  data.path = path;
+  data.time_stamps = detail::read_time_stamps(file);
+  const std::size_t T = data.time_stamps.size();
+
+  const std::string angular_key = file.contains("angular_velocity") ? "angular_velocity" : "rotational_velocity";
+  if (!file.contains(angular_key)) throw parse_error(what("angular_velocity") + " (or 'rotational_velocity') is missing");
+  const auto v = file.array("linear_velocity"), w = file.array(angular_key);
+  detail::require_shape(v, {3, T}, what("linear_velocity"));
+  detail::require_shape(w, {3, T}, what(angular_key));
+  data.calibration = detail::read_calibration(file);
+  data.cam_T_imu = detail::read_extrinsic(file, options, data.extrinsic_key);
+
+  auto frames = detail::read_frames(file, T, data);
   data.first_observations = std::move(frames[0]);
   data.steps.reserve(T - 1);
   for (std::size_t k = 1; k < T; ++k) {

@@ -101,20 +101,23 @@ std::vector<PredictedLandmark> predict_landmarks_in_view(const Backend& backend,
   return out;
 }
 
-/// Associates the frame's features with the predicted landmarks; new landmarks take ids
-/// next_id, next_id + 1, ... (next_id is advanced).
-inline FrameAssociation associate_to_map(const StereoFrame& frame, std::span<const PredictedLandmark> predicted,
-                                         const LandmarkAppearance& appearance, LandmarkId& next_id,
-                                         const MapAssociationOptions& o = {}) {
+namespace detail {
+
+/// A feature paired with a predicted landmark: descriptor distance and normalized innovation.
+struct FeaturePair {
+  std::size_t feature, landmark;
+  double distance, nis;
+};
+
+/// Per feature, its nearest landmark descriptor among the landmarks whose gate it is inside, kept
+/// when within max_descriptor_distance and the ratio test against the second nearest; `gated[i]`:
+/// feature i is inside some gate.
+inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& frame, std::span<const PredictedLandmark> predicted,
+                                                         const LandmarkAppearance& appearance,
+                                                         const MapAssociationOptions& o, std::vector<bool>& gated) {
   const double gate = chi_square_quantile(3, o.gate_probability);
-  struct Pair {
-    std::size_t feature, landmark;
-    double distance, nis;
-  };
-  std::vector<Pair> pairs;
-  std::vector<bool> gated(frame.features.size(), false);
-  // Per feature, its nearest and second-nearest landmark descriptors inside the gates.
-  std::vector<Pair> best(frame.features.size(), Pair{0, 0, std::numeric_limits<double>::infinity(), 0.0});
+  gated.assign(frame.features.size(), false);
+  std::vector<FeaturePair> best(frame.features.size(), FeaturePair{0, 0, std::numeric_limits<double>::infinity(), 0.0});
   std::vector<double> second(frame.features.size(), std::numeric_limits<double>::infinity());
   const int norm = frame.descriptors.type() == CV_8U ? cv::NORM_HAMMING : cv::NORM_L2;
   for (std::size_t j = 0; j < predicted.size(); ++j) {
@@ -134,19 +137,39 @@ inline FrameAssociation associate_to_map(const StereoFrame& frame, std::span<con
       }
     }
   }
+  std::vector<FeaturePair> pairs;
   for (std::size_t i = 0; i < frame.features.size(); ++i)
     if (best[i].distance <= o.max_descriptor_distance && (o.ratio >= 1.0 || best[i].distance < o.ratio * second[i]))
       pairs.push_back(best[i]);
-  std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
+  return pairs;
+}
+
+/// One landmark per feature and one feature per landmark, the closest descriptors first (ties: the
+/// smaller innovation); -1 for a feature left without one.
+inline std::vector<int> one_to_one(std::vector<FeaturePair> pairs, std::size_t features, std::size_t landmarks) {
+  std::sort(pairs.begin(), pairs.end(), [](const FeaturePair& a, const FeaturePair& b) {
     return a.distance != b.distance ? a.distance < b.distance : a.nis < b.nis;
   });
-  std::vector<int> landmark_of(frame.features.size(), -1);
-  std::vector<bool> taken(predicted.size(), false);
-  for (const Pair& p : pairs) {
+  std::vector<int> landmark_of(features, -1);
+  std::vector<bool> taken(landmarks, false);
+  for (const FeaturePair& p : pairs) {
     if (landmark_of[p.feature] >= 0 || taken[p.landmark]) continue;
     landmark_of[p.feature] = static_cast<int>(p.landmark);
     taken[p.landmark] = true;
   }
+  return landmark_of;
+}
+
+}  // namespace detail
+
+/// Associates the frame's features with the predicted landmarks; new landmarks take ids
+/// next_id, next_id + 1, ... (next_id is advanced).
+inline FrameAssociation associate_to_map(const StereoFrame& frame, std::span<const PredictedLandmark> predicted,
+                                         const LandmarkAppearance& appearance, LandmarkId& next_id,
+                                         const MapAssociationOptions& o = {}) {
+  std::vector<bool> gated;
+  const auto landmark_of = detail::one_to_one(detail::gated_descriptor_matches(frame, predicted, appearance, o, gated),
+                                              frame.features.size(), predicted.size());
   FrameAssociation out;
   for (std::size_t i = 0; i < frame.features.size() && out.observations.size() < o.max_observations; ++i) {
     if (landmark_of[i] < 0) continue;
