@@ -99,12 +99,24 @@ INSTANTIATE_TEST_SUITE_P(
         Malformed{"noise", "LANDMARK 0 1 1 0 10 0 10\nLANDMARK 0 2 1 0 20 0 20\n", "landmark noise differs"},
         Malformed{"twice", "LANDMARK 0 1 1 0 10 0 10\nLANDMARK 0 1 1 0 10 0 10\n", "seen twice"},
         // Identifiers that a cast from double would truncate or make undefined (issue 15's UBSan finding).
-        Malformed{"huge_landmark_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 1 6.1e19 1 0 10 0 10\n",
-                  "landmark id must be a non-negative integer below 2^53"},
+        // (Since issue 36 an id beyond 1e12 is refused as a number before it is taken for an id.)
+        Malformed{"huge_landmark_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 1 9e15 1 0 10 0 10\n",
+                  "'9e15' is beyond +-1e12"},
+        // Issue 36: finite numbers too large for the estimators' arithmetic were reported by a filter
+        // ("EKF motion update overflowed") without the file and line.
+        Malformed{"huge_motion", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 1 2 1e308 0 0 50 0 0 50 0 100\n",
+                  "'1e308' is beyond +-1e12"},
+        Malformed{"huge_landmark", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 1 2 1e308 0 10 0 10\n",
+                  "'1e308' is beyond +-1e12"},
+        Malformed{"huge_noise", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 1 2 1 0 0 1e308 0 0 50 0 100\n",
+                  "'1e308' is beyond +-1e12"},
+        Malformed{"huge_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 1 6.1e19 1 0 10 0 10\n", "is beyond +-1e12"},
         Malformed{"negative_pose_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 -1 2 1 0 0 50 0 0 50 0 100\n",
                   "pose id must be a non-negative integer"},
-        Malformed{"huge_pose_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 1e30 2 1 0 10 0 10\n",
-                  "pose id must be a non-negative integer"},
+        Malformed{"huge_pose_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 9e15 2 1 0 10 0 10\n",
+                  "'9e15' is beyond +-1e12"},
+        Malformed{"fractional_landmark_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 1 2.5 1 0 10 0 10\n",
+                  "landmark id must be a non-negative integer below 2^53"},
         Malformed{"fractional_pose_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 1.7 2 1 0 0 50 0 0 50 0 100\n",
                   "pose id must be a non-negative integer"}),
     [](const auto& info) { return std::string(info.param.name); });

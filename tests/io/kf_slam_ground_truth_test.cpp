@@ -47,10 +47,19 @@ TEST_F(GroundTruthFile, BadRowsNameFileAndLine) {
   EXPECT_NE(error_of([&] { read_kf_slam_landmarks<2>(p); }).find(p + ":2: landmark 4 appears twice"), std::string::npos);
   std::ofstream(p) << "1 2 0 5 0 0 -1\n";
   EXPECT_NE(error_of([&] { read_kf_slam_landmarks<2>(p); }).find("non-negative integer"), std::string::npos);
-  for (const char* id : {"6.1e19", "1e30", "2.5"}) {  // issue 15: out of range or fractional ids
+  for (const char* id : {"2.5", "-3"}) {  // issue 15: fractional or negative ids (beyond 1e12: below)
     std::ofstream(p) << "1 2 0 5 0 0 " << id << "\n";
     EXPECT_NE(error_of([&] { read_kf_slam_landmarks<2>(p); }).find("non-negative integer below 2^53"), std::string::npos) << id;
   }
+  // Issue 36: a finite number too large for the estimators' arithmetic (a map coordinate of 1e308 gave
+  // inf errors in every row) is refused at its line, as are ids beyond it (6.1e19, 1e30).
+  for (const char* row : {"1e308 2 0 5 0 0 4\n", "1 2 0 5 0 0 6.1e19\n", "1 2 0 5 0 0 1e30\n"}) {
+    std::ofstream(p) << row;
+    EXPECT_NE(error_of([&] { read_kf_slam_landmarks<2>(p); }).find(p + ":1: "), std::string::npos) << row;
+    EXPECT_NE(error_of([&] { read_kf_slam_landmarks<2>(p); }).find("is beyond +-1e12"), std::string::npos) << row;
+  }
+  std::ofstream(p) << "0 0 0 0 0 0\n-2e13 0 0 0 0 0\n";
+  EXPECT_NE(error_of([&] { read_kf_slam_path(p); }).find(p + ":2: '-2e13' is beyond +-1e12"), std::string::npos);
   std::ofstream(p) << "% nothing\n";
   EXPECT_NE(error_of([&] { read_kf_slam_landmarks<2>(p); }).find("no landmarks"), std::string::npos);
   EXPECT_NE(error_of([&] { read_kf_slam_path(p + ".missing"); }).find("cannot open file"), std::string::npos);

@@ -92,6 +92,8 @@ TEST_F(MrclamFiles, MalformedFilesNameFileAndLine) {
   EXPECT_NE(message().find("Robot1_Measurement.dat:1: range must be positive"), std::string::npos) << message();
   write("Robot1_Measurement.dat", "");
   EXPECT_NE(message().find("Robot1_Measurement.dat: no data rows"), std::string::npos) << message();
+  write("Robot1_Odometry.dat", "100.0 1e308 0.0\n103.0 1.0 0.0\n");  // issue 36: a velocity of 1e308
+  EXPECT_NE(message().find("Robot1_Odometry.dat:1: '1e308' is beyond +-1e12"), std::string::npos) << message();
   fs::remove(dir_ / "Barcodes.dat");
   EXPECT_NE(message().find("Barcodes.dat: cannot open file"), std::string::npos) << message();
   EXPECT_THROW(read_mrclam(dir_.string(), 7), parse_error);

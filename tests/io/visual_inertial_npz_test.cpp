@@ -270,6 +270,12 @@ TEST_F(NpzFiles, MalformedDataSetsAreErrorsNamingFileAndKey) {
   expect(path_with("k_dtype.npz", "K", npy({1, 2}, "(2,)", "<u2")), "key 'K': dtype '<u2' is not supported");
   expect(path_with("dt.npz", "time_stamps", npy({10.0, 10.1, 10.1}, "(1, 3)")), "frame 2 is not later than frame 1");
   expect(path_with("nan.npz", "b", npy({std::nan("")}, "()")), "key 'b': holds a NaN");
+  // Issue 36: time stamps that jump by 1e9 s and values too large for the estimators' arithmetic were
+  // reported by a filter ("innovation covariance of landmark 18 is not positive definite").
+  expect(path_with("jump.npz", "time_stamps", npy({10.0, 10.1, 1e9}, "(1, 3)")),
+         "key 'time_stamps': frame 2 is 999999989.900000 s after frame 1, more than 60.000000 s");
+  expect(path_with("huge.npz", "linear_velocity", npy({1, 2, 3, 4, 1e308, 6, 7, 8, 9}, "(3, 3)")),
+         "key 'linear_velocity': holds 1e+308, beyond +-1e12");
   expect(path_with("baseline.npz", "b", npy({-0.5}, "()")), "the baseline must be positive");
   expect(path_with("rigid.npz", "imu_T_cam", npy({2, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}, "(4, 4)")),
          "not a rigid transform");

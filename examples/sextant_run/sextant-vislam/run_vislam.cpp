@@ -76,6 +76,26 @@ std::optional<std::filesystem::path> clean_twin(const std::filesystem::path& pat
   return std::filesystem::exists(twin) ? std::optional(twin) : std::nullopt;
 }
 
+/// The dead reckoning of the clean file beside a noisy one as the reference: only with as many
+/// frames (else a note says why there is none), and with a warning when its time stamps differ.
+void use_clean_twin(ViData& d, const io::VisualInertialDataset& data, const io::VisualInertialDataset& clean,
+                    const std::filesystem::path& twin) {
+  const std::string name = twin.filename().string();
+  if (clean.steps.size() != data.steps.size()) {
+    std::printf("note: %s has %zu frames, %s %zu: no reference\n", name.c_str(), clean.steps.size() + 1, d.name.c_str(),
+                data.steps.size() + 1);
+    return;
+  }
+  double shift = 0.0;
+  for (std::size_t k = 0; k < data.time_stamps.size(); ++k)
+    shift = std::max(shift, std::abs(clean.time_stamps[k] - data.time_stamps[k]));
+  if (shift > 1e-6)
+    std::printf("warning: the time stamps of %s differ from those of %s by up to %.6g s; its dead reckoning is the "
+                "reference all the same\n", name.c_str(), d.name.c_str(), shift);
+  d.reference = eval::dead_reckoning(d.motion, Eigen::Matrix4d(Eigen::Matrix4d::Identity()), clean.steps);
+  d.reference_label = "dead reckoning of " + name;
+}
+
 ViData from_npz(const std::string& path, const RunnerConfig& c) {
   const auto data = io::read_visual_inertial_npz(path);
   ViData d;
@@ -89,13 +109,7 @@ ViData from_npz(const std::string& path, const RunnerConfig& c) {
   d.prior = {Eigen::Matrix4d::Identity(), 1e-8 * se3::Matrix6d::Identity()};  // the map's frame is the first pose
   d.frames = data.steps;
   d.times.assign(data.time_stamps.begin() + 1, data.time_stamps.end());
-  if (const auto twin = clean_twin(path)) {
-    const auto clean = io::read_visual_inertial_npz(twin->string());
-    if (clean.steps.size() == data.steps.size()) {
-      d.reference = eval::dead_reckoning(d.motion, Eigen::Matrix4d(Eigen::Matrix4d::Identity()), clean.steps);
-      d.reference_label = "dead reckoning of " + twin->filename().string();
-    }
-  }
+  if (const auto twin = clean_twin(path)) use_clean_twin(d, data, io::read_visual_inertial_npz(twin->string()), *twin);
   return d;
 }
 

@@ -91,7 +91,7 @@ inline std::optional<IsamRecord> parse_isam_record(const std::string& line, std:
   if (!(fields >> record.tag) || record.tag[0] == '#') return std::nullopt;
   for (std::string word; fields >> word;) {
     const auto value = parse_finite_number(word);
-    if (!value) throw parse_error(record.where + ": '" + word + "' is not a finite number");
+    if (const auto error = data_number_error(word, value); !error.empty()) throw parse_error(record.where + ": " + error);
     record.values.push_back(*value);
   }
   return record;

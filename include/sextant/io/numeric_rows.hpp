@@ -30,7 +30,8 @@ inline std::vector<std::pair<int, std::vector<double>>> read_numeric_rows(const 
     std::string token;
     while (fields >> token) {
       const auto value = parse_finite_number(token);
-      if (!value) throw parse_error(path + ":" + std::to_string(number) + ": '" + token + "' is not a finite number");
+      if (const auto error = data_number_error(token, value); !error.empty())
+        throw parse_error(path + ":" + std::to_string(number) + ": " + error);
       values.push_back(*value);
     }
     rows.emplace_back(number, std::move(values));

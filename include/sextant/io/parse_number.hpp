@@ -22,6 +22,19 @@ inline std::optional<double> parse_finite_number(const std::string& token) {
   return value;
 }
 
+/// The largest magnitude a number in a data file may have: 1e12 (time stamps in seconds since 1970
+/// are 1.7e9, coordinates in metres, noise values). A finite value beyond it (1e308) would overflow
+/// in the first product an estimator forms, far from the file and line it came from; the readers
+/// refuse it there (data_number_error).
+inline constexpr double kMaxDataMagnitude = 1e12;
+
+/// The message for a token that is not a number a data file may hold, or an empty string when it is one.
+inline std::string data_number_error(const std::string& token, const std::optional<double>& value) {
+  if (!value) return "'" + token + "' is not a finite number";
+  if (std::abs(*value) > kMaxDataMagnitude) return "'" + token + "' is beyond +-1e12, the largest magnitude sextant reads";
+  return {};
+}
+
 /// A number read from text as an identifier: a non-negative integer that a double holds exactly
 /// (below 2^53); nullopt otherwise (negative, fractional, 1e30: casting those would truncate or be
 /// undefined behaviour).

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "sextant/core/observation.hpp"
 #include "sextant/core/se3.hpp"
 #include "sextant/io/npz_reader.hpp"
+#include "sextant/io/parse_number.hpp"
 #include "sextant/models/stereo_imu_se3.hpp"
 
 namespace sextant::io {
@@ -34,6 +36,9 @@ struct VisualInertialNpzOptions {
   /// extrinsic onto the velocities' axes, imu_T_cam <- diag(1, -1, -1, 1) imu_T_cam; an extrinsic
   /// already in y-left axes is left alone. False: every extrinsic as stored.
   bool rebase_forward_right_down_extrinsic = true;
+  /// [s] the longest time between two frames (KITTI's: 0.1 s). A longer one is an error naming the
+  /// frame: the IMU's velocities integrated over it would move the camera by whatever they say.
+  double max_frame_gap = 60.0;
 };
 
 struct VisualInertialDataset {
@@ -58,8 +63,14 @@ inline const NpyArray& require_shape(const NpyArray& a, const std::vector<std::s
     for (const auto d : shape) want += std::to_string(d) + ",";
     throw parse_error(what + ": shape " + have + ") where " + want + ") was expected");
   }
-  for (const double v : a.values)
+  for (const double v : a.values) {
     if (!std::isfinite(v)) throw parse_error(what + ": holds a NaN or infinite value");
+    if (std::abs(v) > kMaxDataMagnitude) {
+      char text[32];
+      std::snprintf(text, sizeof text, "%g", v);
+      throw parse_error(what + ": holds " + text + ", beyond +-1e12, the largest magnitude sextant reads");
+    }
+  }
   return a;
 }
 
@@ -105,16 +116,22 @@ inline double read_scalar(const NpzFile& file, const std::string& key) {
 }
 
 /// time_stamps: shape (1, T) or (T,), strictly increasing.
-inline std::vector<double> read_time_stamps(const NpzFile& file) {
+inline std::vector<double> read_time_stamps(const NpzFile& file, double max_frame_gap) {
   const std::string what = file.path() + ": key 'time_stamps'";
   const auto stamps = file.array("time_stamps");
   if (stamps.values.empty() || stamps.shape.empty() || (stamps.shape.size() == 2 && stamps.shape[0] != 1) || stamps.shape.size() > 2)
     throw parse_error(what + ": expected shape (1, T) or (T,)");
   require_shape(stamps, stamps.shape, what);
-  for (std::size_t k = 1; k < stamps.values.size(); ++k)
-    if (!(stamps.values[k] > stamps.values[k - 1]))
+  for (std::size_t k = 1; k < stamps.values.size(); ++k) {
+    const double dt = stamps.values[k] - stamps.values[k - 1];
+    if (!(dt > 0.0))
       throw parse_error(what + ": frame " + std::to_string(k) + " is not later than frame " + std::to_string(k - 1) +
                         " (dt <= 0)");
+    if (dt > max_frame_gap)
+      throw parse_error(what + ": frame " + std::to_string(k) + " is " + std::to_string(dt) + " s after frame " +
+                        std::to_string(k - 1) + ", more than " + std::to_string(max_frame_gap) +
+                        " s (VisualInertialNpzOptions::max_frame_gap)");
+  }
   return stamps.values;
 }
 
@@ -167,7 +184,7 @@ inline VisualInertialDataset read_visual_inertial_npz(const std::string& path, c
   const auto what = [&](const std::string& key) { return path + ": key '" + key + "'"; };
   VisualInertialDataset data;
   data.path = path;
-  data.time_stamps = detail::read_time_stamps(file);
+  data.time_stamps = detail::read_time_stamps(file, options.max_frame_gap);
   const std::size_t T = data.time_stamps.size();
 
   const std::string angular_key = file.contains("angular_velocity") ? "angular_velocity" : "rotational_velocity";
