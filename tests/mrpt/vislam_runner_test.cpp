@@ -125,4 +125,18 @@ TEST_F(VislamRunner, EkfOn0027NoisyIsTwiceAsCloseToTheCleanReferenceAsDeadReckon
   EXPECT_GE(rmse_of(rows.at("dead reckoning (IMU only)")), 2.0 * rmse_of(rows.at("EKF-SLAM"))) << r.out;
 }
 
+TEST_F(VislamRunner, ACleanTwinWithOtherFramesIsNamedNotSilentlyDropped) {
+  // Issue 36: a NAME_clean.npz beside NAME_noisy.npz with fewer frames was ignored without a word.
+  const auto kitti = sextant::test::shared_data("ece276a/03.npz");
+  const auto clean = sextant::test::shared_data("ece276a/0027_clean.npz");
+  SEXTANT_REQUIRE_DATA(kitti);
+  SEXTANT_REQUIRE_DATA(clean);
+  fs::copy_file(kitti, dir / "pair_noisy.npz");
+  fs::copy_file(clean, dir / "pair_clean.npz");
+  const auto r = run_program(std::string(SEXTANT_VISLAM_EXE) + " -b ekf -d " + (dir / "pair_noisy.npz").string(), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("note: pair_clean.npz has 1106 frames, pair_noisy.npz 1010: no reference"), std::string::npos)
+      << r.out;
+}
+
 }  // namespace
