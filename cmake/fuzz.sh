@@ -68,6 +68,14 @@ mkdir -p "$corpus/runner_config_fuzz"
 printf '[ship]\nruns = 2\nsigma_heading_deg = 15\n[ekf]\ncovariance_update = joseph\n[seif]\nmax_active = 4 // four\n[globe]\nseif_active = 4 8\n' \
   > "$corpus/runner_config_fuzz/sextant.ini"
 
+# Stereo sequences: a calibration of our own (32x24 images) with one pair, and one with a starting
+# state; the parts are separated by "%%" lines (tests/fuzz/stereo_sequence_fuzz.cpp).
+mkdir -p "$corpus/stereo_sequence_fuzz"
+calib='%%YAML:1.0\nK: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: [100, 0, 16, 0, 100, 12, 0, 0, 1]\nbaseline: 0.1\nimage_width: 32\nimage_height: 24\ndt: 0.1\n'
+printf "${calib}%%%%\n000000.png\n000001.png\n%%%%\n000000.png\n000001.png\n" > "$corpus/stereo_sequence_fuzz/pair"
+printf "${calib}initial_state: [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0]\ninitial_sigma: [1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n%%%%\n000000.png\n%%%%\n000000.png\n" \
+  > "$corpus/stereo_sequence_fuzz/with_state"
+
 summary=$build/fuzz-summary.md
 {
   echo "| target | seconds | executions | coverage (edges) | features | corpus | findings |"

@@ -387,22 +387,7 @@ inline std::string documented_defaults() {
 
 namespace detail {
 
-/// Up to 40 characters of `text` with every byte that is not printable ASCII shown as \xHH, so that
-/// a message never echoes raw bytes.
-inline std::string printable_excerpt(const std::string& text, std::size_t length = 40) {
-  std::string out;
-  for (std::size_t i = 0; i < text.size() && i < length; ++i) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-    } else {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "\\x%02x", c);
-      out += hex;
-    }
-  }
-  return text.size() > length ? out + "..." : out;
-}
+using io::printable_excerpt;
 
 /// Reads the ini file line by line before MRPT's parser sees it, and throws "file:line: problem"
 /// for what that parser would pass over in silence: a file it cannot read, bytes that are not text,

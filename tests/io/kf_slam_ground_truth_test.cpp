@@ -63,6 +63,12 @@ TEST_F(GroundTruthFile, BadRowsNameFileAndLine) {
   std::ofstream(p) << "% nothing\n";
   EXPECT_NE(error_of([&] { read_kf_slam_landmarks<2>(p); }).find("no landmarks"), std::string::npos);
   EXPECT_NE(error_of([&] { read_kf_slam_path(p + ".missing"); }).find("cannot open file"), std::string::npos);
+  // Issue 36: a directory where a file is expected said "no data rows".
+  const auto folder = std::filesystem::path(p).parent_path() / "a_folder.txt";
+  std::filesystem::create_directories(folder);
+  EXPECT_NE(error_of([&] { read_kf_slam_path(folder.string()); }).find(folder.string() + ": is a directory, not a file"),
+            std::string::npos);
+  std::filesystem::remove(folder);
 }
 
 }  // namespace

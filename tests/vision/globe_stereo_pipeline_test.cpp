@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -182,7 +183,47 @@ TEST(StereoSequence, BadDirectoriesGiveOneErrorNamingTheFile) {
   cv::imwrite((sizes / "right" / "000000.png").string(), cv::Mat(20, 32, CV_8UC1, cv::Scalar(0)));
   expect_parse_error_naming(sizes, "000000.png", "32x20 pixels, the calibration says 32x24");
 
-  for (const auto& d : {dir, counts, unreadable, sizes}) std::filesystem::remove_all(d);
+  // Issue 36: pairs matched by position whatever their names, a baseline of 1e308 failing in the
+  // filter, a directory taken for calib.yaml or for an image.
+  const auto names = small_sequence("stereo_names");
+  std::filesystem::rename(names / "right" / "000001.png", names / "right" / "000007.png");
+  expect_parse_error_naming(names, "stereo_names", "pair 1 is left/000001.png and right/000007.png");
+  const auto huge = small_sequence("stereo_huge");
+  {
+    std::ifstream in(huge / "calib.yaml");
+    std::string text((std::istreambuf_iterator<char>(in)), {});
+    const auto at = text.find("baseline:");
+    text.replace(at, text.find('\n', at) - at, "baseline: 1e308");
+    write_text(huge / "calib.yaml", text);
+  }
+  expect_parse_error_naming(huge, "calib.yaml", "baseline is beyond +-1e12");
+  const auto folders = small_sequence("stereo_folders");
+  std::filesystem::remove(folders / "calib.yaml");
+  std::filesystem::create_directory(folders / "calib.yaml");
+  expect_parse_error_naming(folders, "calib.yaml", "is a directory, not a file");
+  const auto image_folder = small_sequence("stereo_image_folder");
+  std::filesystem::remove(image_folder / "left" / "000001.png");
+  std::filesystem::create_directory(image_folder / "left" / "000001.png");
+  expect_parse_error_naming(image_folder, "000001.png", "cannot be read as an image (not a file)");
+
+  // Found by the stereo-sequence fuzzer (tests/fuzz/stereo_sequence_fuzz.cpp): a cv::Exception from a
+  // plain list where an opencv-matrix was read, a std::length_error from OpenCV's YAML parser, and a
+  // matrix header of 2^31 rows that OpenCV allocated before anything was checked.
+  const auto fuzzed = small_sequence("stereo_fuzzed");
+  const std::string K = "K: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: [100, 0, 16, 0, 100, 12, 0, 0, 1]\n";
+  const std::string rest = "baseline: 0.1\nimage_width: 32\nimage_height: 24\n";
+  write_text(fuzzed / "calib.yaml", "%YAML:1.0\n" + K + rest + "initial_sigma: [1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n");
+  EXPECT_NO_THROW(StereoSequence{fuzzed});  // a plain list is read as the 12 numbers it is
+  write_text(fuzzed / "calib.yaml", "%YAML:1.0\n" + K + rest + "initial_sigma: {a: 1}\n");
+  expect_parse_error_naming(fuzzed, "calib.yaml", "initial_sigma must hold 12 numbers");
+  write_text(fuzzed / "calib.yaml",
+             "%YAML:1.0\nK: !!opencv-matrix\n  rows: 2147483647\n  cols: 3\n  dt: d\n  data: [1]\n" + rest);
+  expect_parse_error_naming(fuzzed, "calib.yaml", "K is not 3x3");
+  write_text(fuzzed / "calib.yaml",
+             "%YAML:1.0\nK: !!opencv2matrix\n  ro:sw 3\n  cols: 3\n  : !!o\n  data::1.0\nK: !!opencv-mat data: [100,e_width: 3 1\x82 1, 1, 1]\n");
+  expect_parse_error_naming(fuzzed, "calib.yaml", "calib.yaml");
+
+  for (const auto& d : {dir, counts, unreadable, sizes, names, huge, folders, image_folder, fuzzed}) std::filesystem::remove_all(d);
 }
 
 TEST(StereoSequence, AFrameWithoutFeaturesIsAStepWithoutObservations) {

@@ -22,8 +22,7 @@ using IsamDataset = LandmarkDataset<Se2Odometry, PointInRobotFrame2D>;
 /// The noise form of a file, read off its first odometry record: EDGE2 (iSAM) carries the square
 /// root of the information matrix, ODOMETRY (GTSAM) the covariance.
 inline IsamNoise detect_isam_noise(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw parse_error(path + ": cannot open file");
+  std::ifstream in = open_input_file(path);
   std::string line, tag;
   for (int number = 1; std::getline(in, line) && number <= 100000; ++number) {
     std::istringstream fields(line);

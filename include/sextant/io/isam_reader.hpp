@@ -18,6 +18,7 @@
 
 #include "sextant/core/error.hpp"
 #include "sextant/core/observation.hpp"
+#include "sextant/io/input_file.hpp"
 #include "sextant/io/parse_number.hpp"
 #include "sextant/models/point_in_robot_frame_2d.hpp"
 #include "sextant/models/se2_odometry.hpp"
@@ -162,8 +163,7 @@ class IsamDatasetBuilder {
 /// that is not the newest, a landmark seen twice from one pose, or landmark noise that differs
 /// between records.
 inline PlanarDataset read_isam_2d(const std::string& path, IsamNoise form) {
-  std::ifstream in(path);
-  if (!in) throw parse_error(path + ": cannot open file");
+  std::ifstream in = open_input_file(path);
   detail::IsamDatasetBuilder builder(form);
   std::string line;
   for (int number = 1; std::getline(in, line); ++number)

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sextant/core/error.hpp"
+#include "sextant/io/input_file.hpp"
 #include "sextant/io/npy.hpp"
 
 namespace sextant::io {
@@ -27,6 +28,7 @@ class NpzFile {
   /// so a truncated file fails here.
   explicit NpzFile(std::string path, std::size_t max_entry_bytes = kDefaultMaxEntryBytes)
       : path_(std::move(path)), max_entry_bytes_(max_entry_bytes) {
+    require_input_file(path_);
     int error_code = 0;
     zip_t* archive = zip_open(path_.c_str(), ZIP_RDONLY | ZIP_CHECKCONS, &error_code);
     if (!archive) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sextant/core/error.hpp"
+#include "sextant/io/input_file.hpp"
 #include "sextant/io/parse_number.hpp"
 
 namespace sextant::io {
@@ -18,8 +19,7 @@ namespace detail {
 /// The numeric rows of a whitespace-separated text file, each with its line number; throws
 /// parse_error naming file:line for a token that is not a finite number.
 inline std::vector<std::pair<int, std::vector<double>>> read_numeric_rows(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw parse_error(path + ": cannot open file");
+  std::ifstream in = open_input_file(path);
   std::vector<std::pair<int, std::vector<double>>> rows;
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {

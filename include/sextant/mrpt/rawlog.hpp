@@ -37,6 +37,7 @@
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/observation.hpp"
 #include "sextant/io/ids_from_ground_truth.hpp"
+#include "sextant/io/input_file.hpp"
 #include "sextant/io/kf_slam_ground_truth.hpp"
 #include "sextant/io/landmark_dataset.hpp"
 #include "sextant/mrpt/exception_text.hpp"
@@ -64,7 +65,7 @@ namespace detail {
 
 /// Every serialized object of the file, in order.
 inline std::vector<::mrpt::serialization::CSerializable::Ptr> read_objects(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw parse_error(path + ": cannot open file (no such file)");
+  io::require_input_file(path);
   ::mrpt::io::CFileGZInputStream in;
   if (!in.open(path)) throw parse_error(path + ": cannot open file");
   auto archive = ::mrpt::serialization::archiveFrom(in);

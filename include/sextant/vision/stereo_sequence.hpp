@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
@@ -19,6 +20,7 @@
 
 #include "sextant/core/error.hpp"
 #include "sextant/core/gaussian.hpp"
+#include "sextant/io/parse_number.hpp"
 #include "sextant/models/euler_camera_12d.hpp"
 #include "sextant/vision/stereo_triangulation.hpp"
 
@@ -44,18 +46,35 @@ inline cv::Mat as_cv_row(const Eigen::Matrix<double, 12, 1>& v) {
   return m;
 }
 
+/// Whether `node` is an opencv-matrix of rows x cols, read off its header before OpenCV allocates
+/// the matrix (a header of 2^31 rows would otherwise allocate first).
+inline bool is_matrix_of(const cv::FileNode& node, int rows, int cols) {
+  if (!node.isMap() || !node["rows"].isInt() || !node["cols"].isInt()) return false;
+  return static_cast<int>(node["rows"]) == rows && static_cast<int>(node["cols"]) == cols;
+}
+
 /// An optional 12-vector: absent gives nothing; present but not 12 finite numbers is an error.
 inline std::optional<Eigen::Matrix<double, 12, 1>> read_vector12(const cv::FileStorage& fs, const char* key,
                                                                 const std::string& file) {
   const cv::FileNode node = fs[key];
   if (node.empty()) return std::nullopt;
-  cv::Mat m;
-  node >> m;
-  if (m.total() != 12 || m.channels() != 1)
-    throw parse_error(file + ": " + key + " must hold 12 numbers (p, eta, v, omega)");
-  m.convertTo(m, CV_64F);
   Eigen::Matrix<double, 12, 1> out;
-  for (int i = 0; i < 12; ++i) out(i) = m.at<double>(i);
+  if (node.isSeq()) {  // a plain YAML list [a, b, ...]
+    if (node.size() != 12) throw parse_error(file + ": " + key + " must hold 12 numbers (p, eta, v, omega)");
+    for (int i = 0; i < 12; ++i) {
+      if (!node[i].isReal() && !node[i].isInt()) throw parse_error(file + ": " + key + " must hold 12 numbers");
+      out(i) = static_cast<double>(node[i]);
+    }
+  } else {  // an opencv-matrix (what write_calibration writes)
+    if (!is_matrix_of(node, 1, 12) && !is_matrix_of(node, 12, 1))
+      throw parse_error(file + ": " + key + " must hold 12 numbers (p, eta, v, omega)");
+    cv::Mat m;
+    node >> m;
+    if (m.total() != 12 || m.channels() != 1)
+      throw parse_error(file + ": " + key + " must hold 12 numbers (p, eta, v, omega)");
+    m.convertTo(m, CV_64F);
+    for (int i = 0; i < 12; ++i) out(i) = m.at<double>(i);
+  }
   if (!out.allFinite()) throw parse_error(file + ": " + key + " has NaN or Inf");
   return out;
 }
@@ -64,7 +83,7 @@ inline std::vector<std::filesystem::path> images_in(const std::filesystem::path&
   if (!std::filesystem::is_directory(dir)) throw parse_error(dir.string() + ": no such directory");
   std::vector<std::filesystem::path> out;
   for (const auto& entry : std::filesystem::directory_iterator(dir))
-    if (entry.is_regular_file() && entry.path().extension() == ".png") out.push_back(entry.path());
+    if (entry.path().extension() == ".png") out.push_back(entry.path());  // one that is no file fails when read
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -74,16 +93,51 @@ inline std::vector<std::filesystem::path> images_in(const std::filesystem::path&
 /// Reads <dir>/calib.yaml. Throws parse_error naming the file for a missing or unreadable file, K
 /// missing or not 3x3 with fx = fy, a baseline missing or not positive, an image size missing or
 /// not positive, or a dt that is not positive.
+namespace detail {
+/// Every number of the calibration within +-1e12 (io::kMaxDataMagnitude) and the image no larger
+/// than 2^16 pixels a side: a baseline of 1e308 failed far away, in a filter, without the file.
+inline void require_plausible(const StereoCalibration& c, const std::string& file) {
+  auto check = [&](double value, const char* what) {
+    if (std::abs(value) > io::kMaxDataMagnitude)
+      throw parse_error(file + ": " + what + " is beyond +-1e12, the largest magnitude sextant reads");
+  };
+  for (int i = 0; i < 9; ++i) check(c.K(i / 3, i % 3), "an entry of K");
+  check(c.baseline, "baseline");
+  check(c.dt, "dt");
+  for (const auto& v : {c.initial_state, c.initial_sigma})
+    if (v)
+      for (double x : *v) check(x, "an entry of initial_state or initial_sigma");
+  if (c.width > 65536 || c.height > 65536) throw parse_error(file + ": image size above 65536 pixels a side");
+}
+}  // namespace detail
+
+inline StereoCalibration read_calibration_from(const cv::FileStorage& fs, const std::string& file);
+
 inline StereoCalibration read_calibration(const std::filesystem::path& dir) {
   const std::string file = detail::calibration_file(dir).string();
+  if (std::filesystem::is_directory(file)) throw parse_error(file + ": is a directory, not a file (the stereo calibration)");
   if (!std::filesystem::is_regular_file(file)) throw parse_error(file + ": no such file (the stereo calibration)");
   cv::FileStorage fs;
-  try {
-    if (!fs.open(file, cv::FileStorage::READ)) throw parse_error(file + ": cannot be read as YAML");
-  } catch (const cv::Exception& e) {
-    throw parse_error(file + ": cannot be read as YAML (" + e.msg + ")");
+  bool opened = false;
+  try {  // OpenCV's parser throws cv::Exception, and on some malformed files std::length_error
+    opened = fs.open(file, cv::FileStorage::READ);
+  } catch (const std::exception& e) {
+    throw parse_error(file + ": cannot be read as YAML (" + io::printable_excerpt(e.what(), 200) + ")");
   }
+  if (!opened) throw parse_error(file + ": cannot be read as YAML");
+  try {  // OpenCV asserts on a node of the wrong kind (a list where a map is read): an error of the file
+    return read_calibration_from(fs, file);
+  } catch (const error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw parse_error(file + ": " + io::printable_excerpt(e.what(), 200));
+  }
+}
+
+/// The calibration's keys (read_calibration).
+inline StereoCalibration read_calibration_from(const cv::FileStorage& fs, const std::string& file) {
   StereoCalibration c;
+  if (!fs["K"].empty() && !detail::is_matrix_of(fs["K"], 3, 3)) throw parse_error(file + ": K is not 3x3");
   cv::Mat K;
   fs["K"] >> K;
   if (K.empty()) throw parse_error(file + ": no K (the 3x3 camera matrix)");
@@ -107,6 +161,7 @@ inline StereoCalibration read_calibration(const std::filesystem::path& dir) {
   c.initial_sigma = detail::read_vector12(fs, "initial_sigma", file);
   if (c.initial_sigma && !(c.initial_sigma->array() > 0.0).all())
     throw parse_error(file + ": initial_sigma must be positive");
+  detail::require_plausible(c, file);
   return c;
 }
 
@@ -158,6 +213,10 @@ class StereoSequence {
     if (left_.size() != right_.size())
       throw parse_error(dir.string() + ": " + std::to_string(left_.size()) + " left images but " +
                         std::to_string(right_.size()) + " right images");
+    for (std::size_t k = 0; k < left_.size(); ++k)  // a pair shares its name (KITTI, EuRoC, ours)
+      if (left_[k].filename() != right_[k].filename())
+        throw parse_error(dir.string() + ": pair " + std::to_string(k) + " is left/" + left_[k].filename().string() +
+                          " and right/" + right_[k].filename().string() + ": the two images of a pair must share a name");
   }
 
   std::size_t size() const { return left_.size(); }
@@ -169,7 +228,18 @@ class StereoSequence {
 
  private:
   cv::Mat read(const std::filesystem::path& file) const {
-    cv::Mat image = cv::imread(file.string(), cv::IMREAD_GRAYSCALE);
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec)) throw parse_error(file.string() + ": cannot be read as an image (not a file)");
+    // OpenCV logs a warning of its own for a file no decoder knows; the error below says it once.
+    const auto level = cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
+    cv::Mat image;
+    try {
+      image = cv::imread(file.string(), cv::IMREAD_GRAYSCALE);
+    } catch (const cv::Exception& e) {
+      cv::utils::logging::setLogLevel(level);
+      throw parse_error(file.string() + ": cannot be read as an image (" + io::printable_excerpt(e.msg, 200) + ")");
+    }
+    cv::utils::logging::setLogLevel(level);
     if (image.empty()) throw parse_error(file.string() + ": cannot be read as an image");
     if (image.cols != calibration_.width || image.rows != calibration_.height)
       throw parse_error(file.string() + ": " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
