@@ -1,11 +1,12 @@
 #pragma once
-// libFuzzer hands bytes; sextant's readers take paths. One temporary file per fuzzing process,
-// rewritten for every input (unique name, removed at exit).
+// libFuzzer hands bytes; sextant's readers take paths. One temporary file (or directory) per
+// fuzzing process, rewritten for every input (unique name, removed at exit).
 #include <unistd.h>
 
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
 namespace sextant::fuzz {
@@ -26,6 +27,21 @@ class InputFile {
     if (!f || std::fwrite(data, 1, size, f) != size || std::fclose(f) != 0) std::abort();
     return path_;
   }
+
+ private:
+  std::string path_;
+};
+
+/// A directory of its own for the fuzzing process, removed at exit (readers of several files).
+class InputDirectory {
+ public:
+  explicit InputDirectory(const char* name) {
+    const char* dir = std::getenv("TMPDIR");
+    path_ = std::string(dir && *dir ? dir : "/tmp") + "/sextant_fuzz_" + name + "_XXXXXX";
+    if (!mkdtemp(path_.data())) std::abort();
+  }
+  ~InputDirectory() { std::filesystem::remove_all(path_); }
+  const std::string& path() const { return path_; }
 
  private:
   std::string path_;

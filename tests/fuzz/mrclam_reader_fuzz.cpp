@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 
+#include "fuzz_input_file.hpp"
 #include "sextant/core/error.hpp"
 #include "sextant/io/mrclam_reader.hpp"
 
@@ -18,30 +19,20 @@ namespace {
 constexpr std::array<const char*, 5> kFiles = {"Barcodes.dat", "Landmark_Groundtruth.dat", "Robot1_Odometry.dat",
                                                "Robot1_Measurement.dat", "Robot1_Groundtruth.dat"};
 
-/// A directory of its own for the fuzzing process, removed at exit.
-struct InputDirectory {
-  std::string path;
-  InputDirectory() {
-    const char* tmp = std::getenv("TMPDIR");
-    path = std::string(tmp && *tmp ? tmp : "/tmp") + "/sextant_fuzz_mrclam_XXXXXX";
-    if (!mkdtemp(path.data())) std::abort();
-  }
-  ~InputDirectory() { std::filesystem::remove_all(path); }
-};
 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const InputDirectory dir;
+  static const sextant::fuzz::InputDirectory dir("mrclam");
   std::string_view rest(reinterpret_cast<const char*>(data), size);
   for (const char* name : kFiles) {
     const auto separator = rest.find("%%\n");
     const std::string_view part = rest.substr(0, separator);
     rest = separator == std::string_view::npos ? std::string_view() : rest.substr(separator + 3);
-    std::ofstream(dir.path + "/" + name, std::ios::binary) << part;
+    std::ofstream(dir.path() + "/" + name, std::ios::binary) << part;
   }
   try {
-    (void)sextant::io::read_mrclam(dir.path, 1);
+    (void)sextant::io::read_mrclam(dir.path(), 1);
   } catch (const sextant::error&) {
   }
   return 0;

@@ -15,21 +15,12 @@
 #include <string>
 #include <string_view>
 
+#include "fuzz_input_file.hpp"
 #include "sextant/core/error.hpp"
 #include "sextant/vision/stereo_sequence.hpp"
 
 namespace {
 
-/// A directory of its own for the fuzzing process, removed at exit.
-struct InputDirectory {
-  std::string path;
-  InputDirectory() {
-    const char* tmp = std::getenv("TMPDIR");
-    path = std::string(tmp && *tmp ? tmp : "/tmp") + "/sextant_fuzz_stereo_XXXXXX";
-    if (!mkdtemp(path.data())) std::abort();
-  }
-  ~InputDirectory() { std::filesystem::remove_all(path); }
-};
 
 std::string_view next_part(std::string_view& rest) {
   const auto separator = rest.find("%%\n");
@@ -66,8 +57,8 @@ void write_side(const std::filesystem::path& side, std::string_view names) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const InputDirectory dir;
-  const std::filesystem::path root(dir.path);
+  static const sextant::fuzz::InputDirectory dir("stereo");
+  const std::filesystem::path root(dir.path());
   for (const char* side : {"left", "right"}) std::filesystem::remove_all(root / side);
   std::filesystem::remove_all(root / "calib.yaml");
   std::string_view rest(reinterpret_cast<const char*>(data), size);
