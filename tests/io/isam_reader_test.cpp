@@ -55,6 +55,15 @@ TEST(IsamReader, ReadsCovarianceRecordsAndObservationsOfTheFirstPose) {
   ASSERT_EQ(data.initial_observations.size(), 1u);
   EXPECT_EQ(data.landmark_cov(0, 1), 0.1);
   EXPECT_EQ(data.steps[0].control.cov(1, 1), 4e-06);
+  // Issue 36: a covariance of 1e-300 was accepted and failed in a filter without the file and line.
+  const auto tiny = write_file("tiny_cov", "LANDMARK 4 5 11.5 -3.2 0.4 0.1 0.4\n"
+                                           "ODOMETRY 4 6 0.08 0 0.001 1e-300 0 0 4e-06 0 4e-06\n");
+  try {
+    read_isam_2d(tiny, IsamNoise::covariance);
+    ADD_FAILURE() << "a variance of 1e-300 was read";
+  } catch (const parse_error& e) {
+    EXPECT_NE(std::string(e.what()).find(tiny + ":2: a variance below 1e-24"), std::string::npos) << e.what();
+  }
 }
 
 TEST(IsamReader, GroundTruthComposesOdometryAndLandmarks) {

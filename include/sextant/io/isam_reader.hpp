@@ -55,6 +55,10 @@ Eigen::Matrix<double, N, N> noise_covariance(const std::vector<double>& values, 
     const Eigen::Matrix<double, N, N> cov = from_upper_triangle<N>(values);
     if (Eigen::LLT<Eigen::Matrix<double, N, N>>(cov).info() != Eigen::Success)
       throw parse_error(where + ": covariance is not positive definite");
+    // A variance of 1e-300 is positive, but its information (1e300) overflows the first product an
+    // estimator forms with it, far from this line (Victoria Park's smallest is 6e-8).
+    if ((cov.diagonal().array() < 1e-24).any())
+      throw parse_error(where + ": a variance below 1e-24 (a standard deviation below 1e-12)");
     return cov;
   }
   Eigen::Matrix<double, N, N> R = from_upper_triangle<N>(values);  // upper-triangular square root
