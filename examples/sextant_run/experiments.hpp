@@ -46,6 +46,14 @@ inline bool left_out(BackendKind kind, const RunnerConfig& c, const std::string&
   return true;
 }
 
+/// The row of a back-end that failed as a whole: its message instead of scores.
+inline TableRow failed_row(const std::string& dataset, const BackendChoice& choice, const error& e) {
+  TableRow row{dataset, choice.key, choice.label, {}, 1, std::nullopt, std::nullopt};
+  row.summary.mark_unscored();
+  row.failure = e.what();
+  return row;
+}
+
 /// Runs one back-end over the data set; on_step(k) after every step.
 template <class Dataset, class OnStep>
 BackendRun<Dataset> run_backend(const BackendChoice& choice, const Dataset& data, const RunnerConfig& c,
@@ -58,14 +66,16 @@ BackendRun<Dataset> run_backend(const BackendChoice& choice, const Dataset& data
     if constexpr (requires { backend.particles(); })
       for (const auto& particle : backend.particles()) out.particles.push_back(particle.x);
   };
-  /// Scored against the ground truth, or only recorded when the data set has none.
+  /// Scored against the ground truth, or only recorded when the data set has none; a step that
+  /// fails is counted in the run and skipped, never the end of the run (eval::StepErrors::skip).
+  constexpr auto on_error = eval::StepErrors::skip;
   const auto evaluate = [&](auto& backend) {
     if constexpr (requires { data.has_ground_truth(); })
-      if (!data.has_ground_truth()) return eval::record_unscored_run(backend, data, on_step);
+      if (!data.has_ground_truth()) return eval::record_unscored_run(backend, data, on_step, on_error);
     if constexpr (requires { backend.optimize(); })
-      return eval::evaluate_smoothed_run(backend, data, scoring.position_dim, on_step);
+      return eval::evaluate_smoothed_run(backend, data, scoring.position_dim, on_step, on_error);
     else
-      return eval::evaluate_run(backend, data, scoring.position_dim, on_step);
+      return eval::evaluate_run(backend, data, scoring.position_dim, on_step, on_error);
   };
   with_backend(choice, data.motion, data.sensor, data.prior, [&](auto& backend) {
     if (c.association.method && associates(choice.kind)) {  // the ids withheld and associated
@@ -104,9 +114,15 @@ std::vector<TableRow> run_on_rawlog(const std::string& name, const Dataset& data
     const BackendKind kind = choice.kind;
     if (left_out(kind, c, name)) continue;
     ProgressBar progress(name + ": " + choice.key, data.steps.size());
-    auto result = run_backend(choice, data, c, [&](std::size_t) { progress.advance(); });
+    BackendRun<Dataset> result;
+    try {
+      result = run_backend(choice, data, c, [&](std::size_t) { progress.advance(); });
+    } catch (const error& e) {  // the back-end as a whole (its construction, optimize(), map()): its row says so
+      rows.push_back(failed_row(name, choice, e));
+      continue;
+    }
     rows.push_back({name, choice.key, choice.label,
-                    eval::summarize(std::vector{result.run}, scoring.pose_dof, scoring.landmark_dof), 1, std::nullopt});
+                    eval::summarize(std::vector{result.run}, scoring.pose_dof, scoring.landmark_dof), 1, std::nullopt, std::nullopt});
     if (const auto& a = result.association) rows.back().association = association_row(*a);
     if constexpr (requires { data.has_ground_truth(); })
       if (!data.has_ground_truth()) rows.back().summary.mark_unscored();
@@ -128,19 +144,25 @@ std::vector<TableRow> run_on_ship(const std::vector<BackendKind>& kinds, const R
     ProgressBar progress("ship: " + choice.key, static_cast<std::size_t>(c.ship_runs));
     std::optional<BackendRun<Dataset>> first;
     std::mutex first_mutex;
-    const auto runs = eval::monte_carlo(c.ship_runs, c.ship.seed, [&](std::uint64_t seed) {
-      sim::Ship2DOptions o = c.ship;
-      o.seed = seed;
-      auto result = run_backend(choice, sim::simulate_ship_2d(o), c, [](std::size_t) {});
-      progress.advance();
-      if (seed == c.ship.seed) {
-        std::lock_guard lock(first_mutex);
-        first = result;
-      }
-      return result.run;
-    });
+    std::vector<eval::RunSummary<typename BackendRun<Dataset>::State>> runs;
+    try {
+      runs = eval::monte_carlo(c.ship_runs, c.ship.seed, [&](std::uint64_t seed) {
+        sim::Ship2DOptions o = c.ship;
+        o.seed = seed;
+        auto result = run_backend(choice, sim::simulate_ship_2d(o), c, [](std::size_t) {});
+        progress.advance();
+        if (seed == c.ship.seed) {
+          std::lock_guard lock(first_mutex);
+          first = result;
+        }
+        return result.run;
+      });
+    } catch (const error& e) {  // one seed's back-end as a whole: the row says so, the others still run
+      rows.push_back(failed_row("ship", choice, e));
+      continue;
+    }
     rows.push_back({"ship", choice.key, choice.label,
-                    eval::summarize(runs, scoring.pose_dof, scoring.landmark_dof), c.ship_runs, std::nullopt});
+                    eval::summarize(runs, scoring.pose_dof, scoring.landmark_dof), c.ship_runs, std::nullopt, std::nullopt});
     if (const auto& a = first->association)  // the first seed's
       rows.back().association = association_row(*a);
     first_runs.emplace_back(kind, std::move(*first));

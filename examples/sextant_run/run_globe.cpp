@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <sextant/eval/camera_scores.hpp>
 #include <sextant/eval/pooled_run.hpp>
 #include <sextant/io/csv_writer.hpp>
@@ -52,6 +53,8 @@ struct GlobeRun {
   std::vector<double> graph_update_position_mae;  ///< GraphSLAM: position MAE after each global update
   double marginal_seconds = 0.0;                  ///< GraphSLAM: recovering the marginals for the NEES
   std::vector<std::size_t> nees_steps;            ///< the step of each pose NEES in scores
+  eval::StepFailures failures;                    ///< steps that failed and were skipped
+  std::optional<std::string> failure;             ///< why the back-end as a whole gave no result
 };
 
 /// The landmarks of `map` that have a true point (a rendered front-end may propose a landmark whose
@@ -64,11 +67,13 @@ std::vector<LandmarkEstimate<3>> with_truth(std::vector<LandmarkEstimate<3>> map
 template <class Backend>
 GlobeRun run_filter(Backend& backend, const Dataset& data, const RunnerConfig& c, std::string key, std::string label) {
   ProgressBar progress("globe: " + key, data.steps.size());
-  auto run = eval::run_through_pool(backend, data.steps, c.globe.pool, c.globe.covariance_period,
-                                    [&](std::size_t, const Backend&) { progress.advance(); });
+  auto run = eval::run_through_pool(
+      backend, data.steps, c.globe.pool, c.globe.covariance_period,
+      [&](std::size_t, const Backend&) { progress.advance(); }, eval::StepErrors::skip);
   GlobeRun out;
   out.key = std::move(key);
   out.label = std::move(label);
+  out.failures = run.failures;
   out.map = with_truth(backend.map(), data);
   out.scores = eval::score_camera(run.means, run.poses, data.true_poses, out.map, data.true_landmarks);
   out.summary = eval::summarize_camera(out.scores);
@@ -103,11 +108,13 @@ void score_smoothed_marginals(const Graph& graph, const Dataset& data, const Run
 template <class Graph>
 GlobeRun run_graph(Graph& graph, const Dataset& data, const RunnerConfig& c, std::string key, std::string label) {
   ProgressBar progress("globe: " + key, data.steps.size() + static_cast<std::size_t>(c.globe.graph_updates));
-  auto run = eval::run_through_pool(graph, data.steps, c.globe.pool, 0,
-                                    [&](std::size_t, const Graph&) { progress.advance(); });
+  auto run = eval::run_through_pool(
+      graph, data.steps, c.globe.pool, 0, [&](std::size_t, const Graph&) { progress.advance(); },
+      eval::StepErrors::skip);
   GlobeRun out;
   out.key = std::move(key);
   out.label = std::move(label);
+  out.failures = run.failures;
   out.pool = std::move(run.pool);
   out.total_seconds = run.total_seconds;
   for (int update = 0; update < c.globe.graph_updates; ++update) {
@@ -158,13 +165,20 @@ std::vector<BackendChoice> globe_choices(const std::vector<BackendKind>& kinds, 
 
 std::vector<GlobeRun> run_backends(const Dataset& data, const std::vector<BackendKind>& kinds, const RunnerConfig& c) {
   std::vector<GlobeRun> runs;
-  for (const auto& choice : globe_choices(kinds, c))
-    with_backend(choice, data.motion, data.sensor, data.prior, [&](auto& backend) {
-      if constexpr (requires { backend.optimize(); })
-        runs.push_back(run_graph(backend, data, c, choice.key, choice.label));
-      else
-        runs.push_back(run_filter(backend, data, c, choice.key, choice.label));
-    });
+  for (const auto& choice : globe_choices(kinds, c)) try {
+      with_backend(choice, data.motion, data.sensor, data.prior, [&](auto& backend) {
+        if constexpr (requires { backend.optimize(); })
+          runs.push_back(run_graph(backend, data, c, choice.key, choice.label));
+        else
+          runs.push_back(run_filter(backend, data, c, choice.key, choice.label));
+      });
+    } catch (const error& e) {  // the back-end as a whole: its row says so, the others still run
+      GlobeRun failed;
+      failed.key = choice.key;
+      failed.label = choice.label;
+      failed.failure = e.what();
+      runs.push_back(std::move(failed));
+    }
   return runs;
 }
 
@@ -174,6 +188,10 @@ void print_globe_header() {
 }
 
 void print_globe_row(const GlobeRun& r, std::size_t steps) {
+  if (r.failure) {
+    std::printf("%-27s failed: %s\n", r.label.c_str(), r.failure->c_str());
+    return;
+  }
   const auto& s = r.summary;
   auto share = [](double fraction) {
     char text[16];
@@ -192,6 +210,9 @@ void print_globe_row(const GlobeRun& r, std::size_t steps) {
               1e3 * s.map_mae_aligned, share(s.position_nees_inside).c_str(), share(s.rotation_nees_inside).c_str(),
               share(s.map_nees_inside).c_str(), number(s.position_anees).c_str(), r.total_seconds,
               1e3 * r.total_seconds / static_cast<double>(steps));
+  if (r.failures.total() > 0)
+    std::printf("%-27s %zu failed step%s skipped (the back-end kept its state); first: %s\n", "", r.failures.total(),
+                r.failures.total() == 1 ? "" : "s", r.failures.first.c_str());
 }
 
 TableRow table_row(const GlobeRun& r, std::size_t steps) {
@@ -205,7 +226,14 @@ TableRow table_row(const GlobeRun& r, std::size_t steps) {
   s.pose_anees = r.summary.position_anees;
   s.total_seconds = r.total_seconds;
   s.seconds_per_step = r.total_seconds / static_cast<double>(steps);
-  return {"globe", r.key, r.label, s, 1, std::nullopt};
+  s.failed_steps = r.failures.total();
+  s.first_failure = r.failures.first;
+  TableRow row{"globe", r.key, r.label, s, 1, std::nullopt, std::nullopt};
+  if (r.failure) {
+    row.summary.mark_unscored();
+    row.failure = r.failure;
+  }
+  return row;
 }
 
 void write_globe_outputs(const RunOptions& options, const std::string& name, const Dataset& data,
@@ -219,6 +247,7 @@ void write_globe_outputs(const RunOptions& options, const std::string& name, con
                      Eigen::Quaterniond(euler_yxz::rotation(data.true_poses[k].segment<3>(3)))});
   io::write_tum((dir / "ground_truth.tum").string(), truth);
   for (const auto& r : runs) {
+    if (r.failure) continue;
     io::CsvWriter csv((dir / (r.key + "_steps.csv")).string(),
                       {"step", "position_error", "rotation_error", "in_pool", "added", "evicted", "refused"});
     for (std::size_t k = 0; k < r.means.size(); ++k) {

@@ -44,7 +44,19 @@ inline std::string cell(const char* format, double value) {
   return text;
 }
 
+/// A row's second line when some of its steps failed and were skipped (eval::StepErrors::skip).
+inline void print_failed_steps(const TableRow& row) {
+  const auto& s = row.summary;
+  if (s.failed_steps == 0) return;
+  std::printf("%-29s %zu failed step%s skipped (the back-end kept its state), over %d run%s; first: %s\n", "",
+              s.failed_steps, s.failed_steps == 1 ? "" : "s", row.runs, row.runs == 1 ? "" : "s", s.first_failure.c_str());
+}
+
 inline void print_row(const TableRow& row) {
+  if (row.failure) {
+    std::printf("%-29s failed: %s\n", row.label.c_str(), row.failure->c_str());
+    return;
+  }
   const auto& s = row.summary;
   std::printf("%-29s %10s %10s %10s %10s %13s %12s %11s %10.4f %13.1f\n", row.label.c_str(), cell("%.4g", s.pose_mae).c_str(),
               cell("%.4g", s.pose_mae_aligned).c_str(), cell("%.4g", s.map_mae).c_str(), cell("%.4g", s.map_mae_aligned).c_str(),
@@ -53,6 +65,7 @@ inline void print_row(const TableRow& row) {
   if (const auto& a = row.association)
     std::printf("%-29s association: precision %.4f, recall %.4f; %zu wrong pairings, %zu duplicate landmarks, %zu "
                 "discarded\n", "", a->precision, a->recall, a->wrong, a->duplicates, a->discarded);
+  print_failed_steps(row);
 }
 
 inline std::string json_number(double x) {
@@ -62,6 +75,24 @@ inline std::string json_number(double x) {
   return out.str();
 }
 
+/// `text` as the inside of a JSON string.
+inline std::string json_escaped(const std::string& text) {
+  std::string out;
+  for (unsigned char ch : text) {
+    if (ch == '"' || ch == '\\') {
+      out += '\\';
+      out += static_cast<char>(ch);
+    } else if (ch < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", ch);
+      out += escaped;
+    } else {
+      out += static_cast<char>(ch);
+    }
+  }
+  return out;
+}
+
 /// The table as JSON: one object per row.
 inline void write_summary_json(const std::string& path, const std::vector<TableRow>& rows) {
   std::ofstream out(path);
@@ -69,13 +100,14 @@ inline void write_summary_json(const std::string& path, const std::vector<TableR
   out << std::setprecision(10) << "[\n";
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const auto& s = rows[i].summary;
-    out << "  {\"dataset\": \"" << rows[i].dataset << "\", \"backend\": \"" << rows[i].backend << "\", \"label\": \""
-        << rows[i].label << "\", \"runs\": " << rows[i].runs << ", \"pose_mae\": " << json_number(s.pose_mae)
+    out << "  {\"dataset\": \"" << json_escaped(rows[i].dataset) << "\", \"backend\": \"" << rows[i].backend
+        << "\", \"label\": \"" << json_escaped(rows[i].label) << "\", \"runs\": " << rows[i].runs << ", \"pose_mae\": " << json_number(s.pose_mae)
         << ", \"map_mae\": " << json_number(s.map_mae) << ", \"pose_mae_aligned\": " << json_number(s.pose_mae_aligned)
         << ", \"map_mae_aligned\": " << json_number(s.map_mae_aligned) << ", \"pose_nees_inside\": " << json_number(s.pose_nees_inside)
         << ", \"map_nees_inside\": " << json_number(s.map_nees_inside) << ", \"pose_anees\": " << json_number(s.pose_anees)
         << ", \"total_seconds\": " << json_number(s.total_seconds)
-        << ", \"seconds_per_step\": " << json_number(s.seconds_per_step);
+        << ", \"seconds_per_step\": " << json_number(s.seconds_per_step) << ", \"failed_steps\": " << s.failed_steps;
+    if (const auto& f = rows[i].failure) out << ", \"failure\": \"" << json_escaped(*f) << "\"";
     if (const auto& a = rows[i].association)
       out << ", \"association_precision\": " << json_number(a->precision)
           << ", \"association_recall\": " << json_number(a->recall);

@@ -57,6 +57,7 @@ struct TableRow {
   eval::Summary summary;
   int runs = 1;
   std::optional<AssociationRow> association;
+  std::optional<std::string> failure;  ///< why the back-end gave no result: its row prints this instead
 };
 
 }  // namespace sextant::runner

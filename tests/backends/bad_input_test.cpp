@@ -199,3 +199,36 @@ TYPED_TEST(BadInput, NonFiniteOrIndefinitePriorIsRejected) {
 
 }  // namespace
 }  // namespace sextant
+
+namespace sextant {
+namespace {
+
+/// The runner's runs skip a failed step (eval::StepErrors::skip, issues 35 and 36): the run counts it,
+/// names the first, and goes on exactly as if the step's failed part had not been tried, because
+/// the back-end kept its state. Without skip the same run throws.
+TYPED_TEST(BadInput, ARunThatSkipsFailedStepsCountsThemAndGoesOnFromTheKeptState) {
+  auto steps = test::random_linear_steps(12, 5, 3);
+  steps[4].dt = -1.0;                               // predict fails: the step is skipped whole
+  steps[7].observations.back().z(0) = kNaN;         // update fails: the step's predict stands
+  auto skipping = TypeParam::make(BeaconShip2D{}, BeaconOffset2D{}, kPrior);
+  const auto record = eval::run(skipping, steps, eval::NoObserver{}, eval::StepErrors::skip);
+  EXPECT_EQ(record.steps.size(), steps.size());
+  EXPECT_EQ(record.failures.predict, 1u);
+  EXPECT_EQ(record.failures.update, 1u);
+  EXPECT_EQ(record.failures.first.rfind("step 4: predict: ", 0), 0u) << record.failures.first;
+  EXPECT_TRUE(record.steps[7].update.corrected == 0 && record.steps[7].update.initialized == 0);
+
+  auto by_hand = TypeParam::make(BeaconShip2D{}, BeaconOffset2D{}, kPrior);
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    if (k == 4) continue;
+    by_hand.predict(steps[k].control, steps[k].dt);
+    if (k != 7) by_hand.update(steps[k].observations);
+  }
+  Snapshot<typename TestFixture::Backend>(by_hand).expect_same_as(skipping);
+
+  auto propagating = TypeParam::make(BeaconShip2D{}, BeaconOffset2D{}, kPrior);
+  EXPECT_THROW(eval::run(propagating, steps), invalid_input_error);
+}
+
+}  // namespace
+}  // namespace sextant

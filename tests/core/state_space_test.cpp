@@ -2,6 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
+#include "sextant/core/pose3_euler_space.hpp"
+#include "sextant/core/se2_space.hpp"
+#include "sextant/core/se3_space.hpp"
+#include "sextant/models/euler_camera_12d.hpp"
+#include "sextant/models/se2_world_frame.hpp"
+
 namespace sextant {
 namespace {
 
@@ -21,6 +29,85 @@ TEST(EuclideanSpace, PlusAndMinusAreInverse) {
   EXPECT_EQ(Space::minus(Space::plus(a, d), a), d);
   EXPECT_TRUE(Space::is_finite(a));
   EXPECT_FALSE(Space::is_finite(Eigen::Vector3d(1.0, std::numeric_limits<double>::infinity(), 0.0)));
+}
+
+/// Random points of a space and tangents of a given size (angles away from the wrap and, for the
+/// Euler charts, pitch away from its singularity).
+template <class Space>
+struct Sampler {
+  std::mt19937_64 rng{42};
+  typename Space::Tangent tangent(double scale) {
+    std::uniform_real_distribution<double> u(-scale, scale);
+    typename Space::Tangent d;
+    for (int i = 0; i < Space::kDim; ++i) d(i) = u(rng);
+    return d;
+  }
+  typename Space::Point point() {
+    if constexpr (std::is_same_v<typename Space::Point, Eigen::Matrix4d>)
+      return se3::exp(tangent(2.0));
+    else
+      return Space::plus(typename Space::Point(Space::Point::Zero()), tangent(1.2));
+  }
+};
+
+/// Central differences of f(e) in the tangent at e = 0, with f's value compared through `minus`.
+template <int N, class F, class Minus>
+Eigen::Matrix<double, N, N> numeric_jacobian(F f, Minus minus) {
+  constexpr double h = 1e-6;
+  Eigen::Matrix<double, N, N> J;
+  for (int i = 0; i < N; ++i) {
+    Eigen::Matrix<double, N, 1> e = Eigen::Matrix<double, N, 1>::Zero();
+    e(i) = h;
+    J.col(i) = minus(f(e), f(-e)) / (2.0 * h);
+  }
+  return J;
+}
+
+template <class Space>
+class StateSpaceJacobians : public ::testing::Test {};
+using Spaces = ::testing::Types<EuclideanSpace<3>, Se2Space, Se2WorldSpace, Pose3EulerSpace, Se3Space, Se3BodySpace,
+                                EulerCamera12Space>;
+TYPED_TEST_SUITE(StateSpaceJacobians, Spaces);
+
+/// minus_jacobian_first/second and plus_jacobian against numeric differentiation, far from the
+/// identity (residuals of up to a radian and more, steps of 0.3): where the Jacobian of plus is not the identity,
+/// Gauss-Newton, the prior and marginal factors and the filters' covariance after a step need them.
+TYPED_TEST(StateSpaceJacobians, MatchNumericDifferentiationAwayFromZero) {
+  using Space = TypeParam;
+  using Point = typename Space::Point;
+  using Tangent = typename Space::Tangent;
+  constexpr int N = Space::kDim;
+  Sampler<Space> sample;
+  const auto tangent_minus = [](const Tangent& a, const Tangent& b) { return Tangent(a - b); };
+  for (int trial = 0; trial < 20; ++trial) {
+    const Point a = sample.point();
+    const Point b = Space::plus(a, sample.tangent(1.0));
+    const Tangent d = sample.tangent(0.3);  // (a step past |pitch| = pi/2 would mirror the globe camera's chart)
+    const auto first = numeric_jacobian<N>([&](const Tangent& e) { return Space::minus(Space::plus(a, e), b); },
+                                           tangent_minus);
+    const auto second = numeric_jacobian<N>([&](const Tangent& e) { return Space::minus(a, Space::plus(b, e)); },
+                                            tangent_minus);
+    const Point moved = Space::plus(a, d);
+    const auto plus = numeric_jacobian<N>([&](const Tangent& e) { return Space::plus(a, Tangent(d + e)); },
+                                          [&](const Point& p, const Point& q) {
+                                            return Tangent(Space::minus(p, moved) - Space::minus(q, moved));
+                                          });
+    EXPECT_LT((minus_jacobian_first<Space>(a, b) - first).norm(), 1e-6 * (1.0 + first.norm())) << trial;
+    EXPECT_LT((minus_jacobian_second<Space>(a, b) - second).norm(), 1e-6 * (1.0 + second.norm())) << trial;
+    // plus(x, d + e) = plus(plus(x, d), G e): minus(., plus(x, d)) of it is G e to first order, up to
+    // the Jacobian of minus at zero (the identity in every space).
+    EXPECT_LT((plus_jacobian<Space>(a, d) - plus).norm(), 1e-6 * (1.0 + plus.norm())) << trial;
+  }
+}
+
+/// The group spaces' Jacobians are not the identity away from zero (what the fallback would give).
+TEST(StateSpaceJacobians, GroupSpacesDifferFromTheAdditiveFallback) {
+  const Eigen::Matrix4d a = se3::exp((se3::Vector6d() << 1, 2, 3, 0.3, -0.2, 0.5).finished());
+  EXPECT_GT((Se3Space::minus_jacobian_first(a, Eigen::Matrix4d::Identity()) - se3::Matrix6d::Identity()).norm(), 0.1);
+  EXPECT_GT((Se2WorldSpace::plus_jacobian(Eigen::Vector3d(4, 5, 0), Eigen::Vector3d(1, 2, 0.3)) -
+             Eigen::Matrix3d::Identity()).norm(), 1.0);
+  static_assert(has_plus_jacobian_v<Se3Space> && has_plus_jacobian_v<Se2WorldSpace>);
+  static_assert(!has_plus_jacobian_v<Se2Space> && !has_plus_jacobian_v<EuclideanSpace<2>>);
 }
 
 }  // namespace

@@ -127,7 +127,15 @@ INSTANTIATE_TEST_SUITE_P(
         Malformed{"fractional_landmark_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 1 2.5 1 0 10 0 10\n",
                   "landmark id must be a non-negative integer below 2^53"},
         Malformed{"fractional_pose_id", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 1.7 2 1 0 0 50 0 0 50 0 100\n",
-                  "pose id must be a non-negative integer"}),
+                  "pose id must be a non-negative integer"},
+        // Issue 36: square-root information that is all zero, or so small or so large that the
+        // covariance it stands for is no usable noise (variance 1e300 or 1e-300), is refused at its line.
+        Malformed{"zero_square_root_information", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 1 2 1 0 0 0 0 0 0 0 0\n",
+                  "square-root information is singular"},
+        Malformed{"zero_landmark_information", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 1 2 1 0 0 0 0\n",
+                  "square-root information is singular"},
+        Malformed{"vanishing_information", "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nEDGE2 1 2 1 0 0 1e-150 0 0 50 0 100\n",
+                  "a variance above 1e24"}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(IsamReader, MissingOrEmptyFile) {

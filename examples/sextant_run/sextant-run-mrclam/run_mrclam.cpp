@@ -110,7 +110,11 @@ std::vector<TableRow> run_mrclam(const CliOptions& cli, const std::string& datas
                 "a back-end exact from then on has position RMSE %.3f m\n",
                 drift.first_sighting_time, drift.heading_error, drift.floor_rmse);
     std::printf("position RMSE against Vicon [m]: dead reckoning %.3f", drift.rmse);
-    for (const auto& row : part) std::printf(", %s %.3f", row.backend.c_str(), row.summary.pose_rmse);
+    for (const auto& row : part)
+      if (row.failure)
+        std::printf(", %s failed", row.backend.c_str());
+      else
+        std::printf(", %s %.3f", row.backend.c_str(), row.summary.pose_rmse);
     std::printf("\n");
     rows.insert(rows.end(), part.begin(), part.end());
   }

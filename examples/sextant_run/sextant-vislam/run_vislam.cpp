@@ -57,6 +57,8 @@ struct ViRun {
   eval::UpdateTotals updates;  ///< mapped (initialized), corrected, gated (rejected), unusable
   double seconds = 0.0;
   double rmse = std::nan(""), anees = std::nan("");
+  eval::StepFailures failures;         ///< frames whose predict or update failed and were skipped
+  std::optional<std::string> failure;  ///< why the back-end as a whole gave no result
 };
 
 ViData simulated(const RunnerConfig& c) {
@@ -117,9 +119,11 @@ template <class Backend>
 ViRun run_backend(Backend& backend, const ViData& d, PoolLimits pool, std::size_t covariance_period, std::string key,
                   std::string label) {
   ProgressBar progress(d.name + ": " + key, d.frames.size());
-  auto run = eval::run_through_pool(backend, d.frames, pool, covariance_period,
-                                    [&](std::size_t, const Backend&) { progress.advance(); });
+  auto run = eval::run_through_pool(
+      backend, d.frames, pool, covariance_period, [&](std::size_t, const Backend&) { progress.advance(); },
+      eval::StepErrors::skip);
   ViRun out;
+  out.failures = run.failures;
   out.key = std::move(key);
   out.label = std::move(label);
   out.means = std::move(run.means);
@@ -186,14 +190,21 @@ std::vector<BackendChoice> vislam_choices(const std::vector<BackendKind>& kinds,
 
 std::vector<ViRun> run_all(const ViData& d, const std::vector<BackendKind>& kinds, const RunnerConfig& c) {
   std::vector<ViRun> runs{dead_reckoning_row(d)};
-  for (const auto& choice : vislam_choices(kinds, c))
-    with_backend(choice, d.motion, d.sensor, d.prior, [&](auto& backend) {
-      if constexpr (requires { backend.optimize(); })
-        runs.push_back(run_graph(backend, d, choice.key, choice.label));
-      else  // the EKF's pose covariance after every frame, the others' every 10th (a SEIF's costs a factorization)
-        runs.push_back(run_backend(backend, d, c.vislam.pool, choice.kind == BackendKind::ekf ? 1 : 10, choice.key,
-                                   choice.label));
-    });
+  for (const auto& choice : vislam_choices(kinds, c)) try {
+      with_backend(choice, d.motion, d.sensor, d.prior, [&](auto& backend) {
+        if constexpr (requires { backend.optimize(); })
+          runs.push_back(run_graph(backend, d, choice.key, choice.label));
+        else  // the EKF's pose covariance after every frame, the others' every 10th (a SEIF's costs a factorization)
+          runs.push_back(run_backend(backend, d, c.vislam.pool, choice.kind == BackendKind::ekf ? 1 : 10, choice.key,
+                                     choice.label));
+      });
+    } catch (const error& e) {  // the back-end as a whole: its row says so, the others still run
+      ViRun failed;
+      failed.key = choice.key;
+      failed.label = choice.label;
+      failed.failure = e.what();
+      runs.push_back(std::move(failed));
+    }
   return runs;
 }
 
@@ -205,7 +216,7 @@ double trajectory_length(const std::vector<Eigen::Matrix4d>& poses) {
 
 /// Position RMSE against the reference, and with the truth the pose ANEES (6 dof, world-frame error).
 void score(ViRun& r, const ViData& d) {
-  if (d.reference.empty()) return;
+  if (d.reference.empty() || r.failure) return;
   double squared = 0.0;
   for (std::size_t k = 0; k < r.means.size(); ++k)
     squared += (se3::translation(r.means[k]) - se3::translation(d.reference[k])).squaredNorm();
@@ -226,10 +237,17 @@ void print_table(const ViData& d, const std::vector<ViRun>& runs) {
   std::printf("%-38s %9s %8s %8s %9s %7s %8s %9s %8s %9s %9s\n", "back-end", "length[m]", "in state", "mapped",
               "corrected", "gated", "unusable", "RMSE [m]", "vs DR", "pose ANEES", "ms/frame");
   for (const auto& r : runs) {
+    if (r.failure) {
+      std::printf("%-38s failed: %s\n", r.label.c_str(), r.failure->c_str());
+      continue;
+    }
     std::printf("%-38s %9.1f %8zu %8zu %9zu %7zu %8zu %9s %8s %9s %9.2f\n", r.label.c_str(), trajectory_length(r.means),
                 r.in_state, r.updates.initialized, r.updates.corrected, r.updates.rejected, r.updates.unusable, number_or_dash(r.rmse, "%.2f").c_str(),
                 number_or_dash(dead_reckoning_rmse / r.rmse, "%.2fx").c_str(), number_or_dash(r.anees, "%.2f").c_str(),
                 1e3 * r.seconds / static_cast<double>(d.frames.size()));
+    if (r.failures.total() > 0)
+      std::printf("%-38s %zu failed frame%s skipped (the back-end kept its state); first: %s\n", "", r.failures.total(),
+                  r.failures.total() == 1 ? "" : "s", r.failures.first.c_str());
   }
   std::printf("RMSE: position against %s; vs DR: dead reckoning's RMSE over this one (higher is better); in state: "
               "landmarks in the state at the end (pool of at most that many); mapped: landmarks added; unusable: "
@@ -246,7 +264,11 @@ TableRow table_row(const ViData& d, const ViRun& r) {
   s.pose_anees = r.anees;
   s.total_seconds = r.seconds;
   s.seconds_per_step = r.seconds / static_cast<double>(d.frames.size());
-  return {d.name, r.key, r.label, s, 1, std::nullopt};
+  s.failed_steps = r.failures.total();
+  s.first_failure = r.failures.first;
+  TableRow row{d.name, r.key, r.label, s, 1, std::nullopt, std::nullopt};
+  row.failure = r.failure;
+  return row;
 }
 
 void write_outputs(const RunOptions& options, const ViData& d, const std::vector<ViRun>& runs, const RunnerConfig& c) {
@@ -261,6 +283,7 @@ void write_outputs(const RunOptions& options, const ViData& d, const std::vector
   };
   if (!d.reference.empty()) io::write_tum((dir / "reference.tum").string(), tum(d.reference));
   for (const auto& r : runs) {
+    if (r.failure) continue;
     io::write_tum((dir / (r.key + "_trajectory.tum")).string(), tum(r.means));
     if (r.map.empty()) continue;
     io::CsvWriter csv((dir / (r.key + "_map.csv")).string(), {"id", "x", "y", "z"});

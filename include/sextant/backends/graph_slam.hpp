@@ -20,6 +20,7 @@
 #include "sextant/core/robust_kernel.hpp"
 #include "sextant/core/selected_inverse.hpp"
 #include "sextant/core/sparse_cholesky.hpp"
+#include "sextant/core/state_space.hpp"
 #include "sextant/core/update_result.hpp"
 #include "sextant/core/versioned_cache.hpp"
 

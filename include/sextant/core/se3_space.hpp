@@ -37,6 +37,23 @@ struct Se3SpaceOf {
       return se3::log(se3::inverse(b) * a);
   }
   static bool is_finite(const Point& T) { return T.allFinite(); }
+
+  /// The Jacobians of minus and plus (docs/derivations/state_space_jacobians.md), r = minus(a, b):
+  /// d minus(plus(a, e), b) / de at e = 0: world J_l^-1(r), body J_r^-1(r);
+  static se3::Matrix6d minus_jacobian_first(const Point& a, const Point& b) {
+    const Tangent r = minus(a, b);
+    return P == Se3Perturbation::world ? se3::left_jacobian_inverse(r) : se3::right_jacobian_inverse(r);
+  }
+  /// d minus(a, plus(b, e)) / de at e = 0: world -J_r^-1(r), body -J_l^-1(r);
+  static se3::Matrix6d minus_jacobian_second(const Point& a, const Point& b) {
+    const Tangent r = minus(a, b);
+    return P == Se3Perturbation::world ? se3::Matrix6d(-se3::right_jacobian_inverse(r))
+                                       : se3::Matrix6d(-se3::left_jacobian_inverse(r));
+  }
+  /// G with plus(x, d + e) = plus(plus(x, d), G e) to first order in e: world J_l(d), body J_r(d).
+  static se3::Matrix6d plus_jacobian(const Point&, const Tangent& d) {
+    return P == Se3Perturbation::world ? se3::left_jacobian(d) : se3::right_jacobian(d);
+  }
 };
 
 using Se3Space = Se3SpaceOf<Se3Perturbation::world>;

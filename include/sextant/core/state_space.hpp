@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 namespace sextant {
 
@@ -28,5 +29,54 @@ struct EuclideanSpace {
   static Tangent minus(const Point& a, const Point& b) { return a - b; }
   static bool is_finite(const Point& x) { return x.allFinite(); }
 };
+
+/// The Jacobians of a space's minus and plus (docs/derivations/state_space_jacobians.md), as manif
+/// gives them: with r = minus(a, b),
+///   minus_jacobian_first(a, b)  = d minus(plus(a, e), b) / de at e = 0,
+///   minus_jacobian_second(a, b) = d minus(a, plus(b, e)) / de at e = 0,
+///   plus_jacobian(x, d)         = G with plus(x, d + e) = plus(plus(x, d), G e) to first order in e.
+/// A space on a group (Se3Space, Se2WorldSpace) defines them; for an additive chart (plus is +, minus
+/// is -, angles wrapped: EuclideanSpace, Se2Space, Pose3EulerSpace, the globe camera's) they are
+/// I, -I and I exactly, which these give for a space that does not define them.
+/// The square matrix over a space's tangent (its dimension from minus, which every space has).
+template <class Space, class Point>
+using TangentJacobian = Eigen::Matrix<double, decltype(Space::minus(std::declval<const Point&>(),
+                                                                    std::declval<const Point&>()))::RowsAtCompileTime,
+                                      decltype(Space::minus(std::declval<const Point&>(),
+                                                            std::declval<const Point&>()))::RowsAtCompileTime>;
+
+template <class Space, class Point>
+TangentJacobian<Space, Point> minus_jacobian_first(const Point& a, const Point& b) {
+  if constexpr (requires { Space::minus_jacobian_first(a, b); })
+    return Space::minus_jacobian_first(a, b);
+  else
+    return TangentJacobian<Space, Point>::Identity();
+}
+
+template <class Space, class Point>
+TangentJacobian<Space, Point> minus_jacobian_second(const Point& a, const Point& b) {
+  if constexpr (requires { Space::minus_jacobian_second(a, b); })
+    return Space::minus_jacobian_second(a, b);
+  else
+    return -TangentJacobian<Space, Point>::Identity();
+}
+
+template <class Space, class Point, class Tangent>
+TangentJacobian<Space, Point> plus_jacobian(const Point& x, const Tangent& d) {
+  if constexpr (requires { Space::plus_jacobian(x, d); })
+    return Space::plus_jacobian(x, d);
+  else
+    return TangentJacobian<Space, Point>::Identity();
+}
+
+/// Whether minus_jacobian_first<Space> can differ from the identity (the space defines it).
+template <class Space>
+inline constexpr bool has_minus_jacobians_v =
+    requires(const typename Space::Point& a) { Space::minus_jacobian_first(a, a); };
+
+/// Whether plus_jacobian<Space> can differ from the identity (the space defines it).
+template <class Space>
+inline constexpr bool has_plus_jacobian_v =
+    requires(const typename Space::Point& x, const typename Space::Tangent& d) { Space::plus_jacobian(x, d); };
 
 }  // namespace sextant

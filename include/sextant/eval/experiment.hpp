@@ -7,6 +7,7 @@
 #include <chrono>
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "sextant/eval/alignment.hpp"
@@ -35,6 +36,7 @@ struct RunSummary {
   /// averaged over the steps (a filter's early maps count); for full SLAM, the final map's.
   double map_error_over_time = 0.0;
   double total_seconds = 0.0;
+  StepFailures failures;  ///< steps skipped under StepErrors::skip (for_each_step)
 };
 
 namespace detail {
@@ -87,12 +89,15 @@ void add_aligned_errors(Summary& out, const Map& map, const Dataset& dataset, in
 /// predict + update over every step of the data set (for_each_step), each timed into out.seconds
 /// and out.total_seconds; after(k) once step k is done.
 template <class Backend, class Dataset, class Summary, class After>
-void run_timed_steps(Backend& backend, const Dataset& dataset, Summary& out, After after) {
-  for_each_step(backend, dataset.steps, PlainUpdate{}, [&](std::size_t k, double seconds, const UpdateResult&) {
-    out.seconds.push_back(seconds);
-    out.total_seconds += seconds;
-    after(k);
-  });
+void run_timed_steps(Backend& backend, const Dataset& dataset, Summary& out, After after, StepErrors on_error) {
+  for_each_step(
+      backend, dataset.steps, PlainUpdate{},
+      [&](std::size_t k, double seconds, const UpdateResult&) {
+        out.seconds.push_back(seconds);
+        out.total_seconds += seconds;
+        after(k);
+      },
+      failures_under(on_error, out.failures));
 }
 
 /// Full SLAM's optimize(), its time added to out.total_seconds.
@@ -107,10 +112,10 @@ void optimize_timed(Backend& backend, Summary& out) {
 /// Runs `backend` over dataset.steps and scores it against dataset.true_poses (row k + 1 is the
 /// pose after step k) and dataset.true_landmarks. The position error is the norm of the first
 /// `position_dim` entries of minus(estimate, truth) (default: all of them). on_step(k) is called
-/// after step k (progress reports).
+/// after step k (progress reports). on_error: whether a failed step ends the run (for_each_step).
 template <class Backend, class Dataset, class OnStep = NoStepCallback>
 RunSummary<typename Backend::State> evaluate_run(Backend& backend, const Dataset& dataset, int position_dim = -1,
-                                                 OnStep on_step = {}) {
+                                                 OnStep on_step = {}, StepErrors on_error = StepErrors::propagate) {
   using Space = typename Backend::Space;
   RunSummary<typename Backend::State> out;
   double map_error_sum = 0.0;
@@ -121,7 +126,8 @@ RunSummary<typename Backend::State> evaluate_run(Backend& backend, const Dataset
     if (map.empty()) return;
     map_error_sum += mean(evaluate_map(map, dataset.true_landmarks).errors);
     ++steps_with_map;
-  });
+  }, on_error);
+  out.failures = record.failures;
   out.map_error_over_time = steps_with_map ? map_error_sum / static_cast<double>(steps_with_map) : 0.0;
   for (std::size_t k = 0; k < record.steps.size(); ++k) {
     const auto& pose = record.steps[k].pose;
@@ -146,10 +152,11 @@ RunSummary<typename Backend::State> evaluate_run(Backend& backend, const Dataset
 template <class Backend, class Dataset, class OnStep = NoStepCallback>
   requires requires(Backend& b) { b.optimize(); b.trajectory(); }
 RunSummary<typename Backend::State> evaluate_smoothed_run(Backend& backend, const Dataset& dataset, int position_dim = -1,
-                                                          OnStep on_step = {}) {
+                                                          OnStep on_step = {},
+                                                          StepErrors on_error = StepErrors::propagate) {
   using Space = typename Backend::Space;
   RunSummary<typename Backend::State> out;
-  detail::run_timed_steps(backend, dataset, out, on_step);
+  detail::run_timed_steps(backend, dataset, out, on_step, on_error);
   detail::optimize_timed(backend, out);
   const auto trajectory = backend.trajectory();
   for (std::size_t k = 1; k < trajectory.size(); ++k) {
@@ -180,6 +187,8 @@ struct Summary {
   std::optional<Interval> anees_interval;
   double pose_mae_std = 0.0;  ///< standard deviation of the per-run pose MAE
   double map_mae_std = 0.0;
+  std::size_t failed_steps = 0;  ///< steps skipped over all runs (StepErrors::skip)
+  std::string first_failure;     ///< the first run's first skipped step that has one
 
   /// Marks every score NaN (a run without ground truth has only its time).
   void mark_unscored() {
@@ -207,6 +216,8 @@ Summary summarize(const std::vector<RunSummary<State>>& runs, int pose_dof, int 
     s.pose_mae_aligned += mean(r.pose_error_aligned) / n;
     s.map_mae_aligned += mean(r.map_error_aligned) / n;
     nees_averages.push_back(mean(r.pose_nees));
+    s.failed_steps += r.failures.total();
+    if (s.first_failure.empty()) s.first_failure = r.failures.first;
   }
   auto standard_deviation = [](const std::vector<double>& v) {
     const double m = mean(v);
@@ -229,12 +240,16 @@ Summary summarize(const std::vector<RunSummary<State>>& runs, int pose_dof, int 
 /// nothing scored. Full SLAM (optimize() and trajectory()) is optimized once at the end and gives
 /// its smoothed trajectory; a filter its pose after each step.
 template <class Backend, class Dataset, class OnStep = NoStepCallback>
-RunSummary<typename Backend::State> record_unscored_run(Backend& backend, const Dataset& dataset, OnStep on_step = {}) {
+RunSummary<typename Backend::State> record_unscored_run(Backend& backend, const Dataset& dataset, OnStep on_step = {},
+                                                        StepErrors on_error = StepErrors::propagate) {
   RunSummary<typename Backend::State> out;
-  detail::run_timed_steps(backend, dataset, out, [&](std::size_t k) {
-    if constexpr (!requires { backend.optimize(); }) out.trajectory.push_back(backend.pose().mean);
-    on_step(k);
-  });
+  detail::run_timed_steps(
+      backend, dataset, out,
+      [&](std::size_t k) {
+        if constexpr (!requires { backend.optimize(); }) out.trajectory.push_back(backend.pose().mean);
+        on_step(k);
+      },
+      on_error);
   if constexpr (requires { backend.optimize(); backend.trajectory(); }) {
     detail::optimize_timed(backend, out);
     for (const auto& pose : backend.pose_means()) out.trajectory.push_back(pose);

@@ -58,16 +58,18 @@ struct PooledRun {
   std::vector<double> seconds;                    ///< predict + evictions + update of each step
   std::vector<PoolStepRecord> pool;               ///< bookkeeping of each step
   UpdateTotals updates;                           ///< what the updates reported, over all steps
+  StepFailures failures;                          ///< steps skipped under StepErrors::skip
   double total_seconds = 0.0;
 };
 
 /// For every step (for_each_step): predict, evict what the pool asks for, update with the admitted
 /// observations. covariance_period: record pose() after steps k with (k + 1) % period == 0 and after
-/// the last. on_step(k, backend) after step k. Timing excludes the recording.
+/// the last. on_step(k, backend) after step k. Timing excludes the recording. on_error: whether a
+/// failed step ends the run (for_each_step); a failed update may follow the evictions it planned.
 template <class Backend, class Steps, class OnStep>
   requires SlamBackend<Backend>
 auto run_through_pool(Backend& backend, const Steps& steps, PoolLimits limits, std::size_t covariance_period,
-                      OnStep&& on_step) {
+                      OnStep&& on_step, StepErrors on_error = StepErrors::propagate) {
   using Measurement = typename Backend::Measurement;
   PooledRun<typename Backend::State, decltype(backend.pose())> out;
   LandmarkPoolPolicy policy(limits);
@@ -82,7 +84,7 @@ auto run_through_pool(Backend& backend, const Steps& steps, PoolLimits limits, s
     out.means.push_back(pose_mean_of(backend));
     if (is_sampled_step(k, count, covariance_period)) out.poses.push_back({k, backend.pose()});
     on_step(k, std::as_const(backend));
-  });
+  }, failures_under(on_error, out.failures));
   out.pool = policy.history();
   return out;
 }

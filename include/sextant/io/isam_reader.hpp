@@ -48,6 +48,20 @@ Eigen::Matrix<double, N, N> from_upper_triangle(const std::vector<double>& value
   return out;
 }
 
+/// A covariance an estimator can use: every variance in [1e-24, 1e24] (standard deviations from
+/// 1e-12 to 1e12). Outside it the record is legal arithmetic but not usable: a variance of 1e-300
+/// (or a square-root information of 1e150) makes an information of 1e300 that overflows the first
+/// product an estimator forms with it, and one of 1e300 (a square-root information of 1e-150) is no
+/// measurement at all; either would fail far from this line. Victoria Park's smallest variance is
+/// 6e-8, cityTrees10000's largest 1e-4.
+template <int N>
+void require_usable_covariance(const Eigen::Matrix<double, N, N>& cov, const std::string& where, const char* form) {
+  if ((cov.diagonal().array() < 1e-24).any())
+    throw parse_error(where + ": a variance below 1e-24 (a standard deviation below 1e-12) from this " + form);
+  if (!((cov.diagonal().array() <= 1e24).all()))
+    throw parse_error(where + ": a variance above 1e24 (a standard deviation above 1e12) from this " + form);
+}
+
 /// Covariance from the record's noise values.
 template <int N>
 Eigen::Matrix<double, N, N> noise_covariance(const std::vector<double>& values, IsamNoise form, const std::string& where) {
@@ -55,18 +69,19 @@ Eigen::Matrix<double, N, N> noise_covariance(const std::vector<double>& values, 
     const Eigen::Matrix<double, N, N> cov = from_upper_triangle<N>(values);
     if (Eigen::LLT<Eigen::Matrix<double, N, N>>(cov).info() != Eigen::Success)
       throw parse_error(where + ": covariance is not positive definite");
-    // A variance of 1e-300 is positive, but its information (1e300) overflows the first product an
-    // estimator forms with it, far from this line (Victoria Park's smallest is 6e-8).
-    if ((cov.diagonal().array() < 1e-24).any())
-      throw parse_error(where + ": a variance below 1e-24 (a standard deviation below 1e-12)");
+    require_usable_covariance<N>(cov, where, "covariance");
     return cov;
   }
   Eigen::Matrix<double, N, N> R = from_upper_triangle<N>(values);  // upper-triangular square root
   R.template triangularView<Eigen::StrictlyLower>().setZero();
+  if ((R.diagonal().array() == 0.0).any())  // all zero, or a zero on the diagonal: no information in some direction
+    throw parse_error(where + ": square-root information is singular (a zero on its diagonal)");
   const Eigen::Matrix<double, N, N> information = R.transpose() * R;
   const Eigen::LLT<Eigen::Matrix<double, N, N>> llt(information);
   if (llt.info() != Eigen::Success) throw parse_error(where + ": square-root information is singular");
-  return llt.solve(Eigen::Matrix<double, N, N>::Identity());
+  const Eigen::Matrix<double, N, N> cov = llt.solve(Eigen::Matrix<double, N, N>::Identity());
+  require_usable_covariance<N>(cov, where, "square-root information");
+  return cov;
 }
 
 /// One line of an iSAM file: its tag and values, and where it is for messages.

@@ -52,6 +52,31 @@ struct Se2WorldSpace {
     T(1, 2) = x(0);
     return T;
   }
+  /// The Jacobians of minus and plus (docs/derivations/state_space_jacobians.md), J = [0 -1; 1 0],
+  /// r = minus(a, b): d minus(plus(a, e), b) / de = [I J r_p; 0 1] (a turn of a about the origin
+  /// turns the residual's position with it);
+  static Eigen::Matrix3d minus_jacobian_first(const Point& a, const Point& b) {
+    const Tangent r = minus(a, b);
+    Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+    D(0, 2) = -r(1);
+    D(1, 2) = r(0);
+    return D;
+  }
+  /// d minus(a, plus(b, e)) / de = [-Rot(r_h) 0; 0 -1];
+  static Eigen::Matrix3d minus_jacobian_second(const Point& a, const Point& b) {
+    const double h = wrap_angle(a(2) - b(2)), c = std::cos(h), s = std::sin(h);
+    Eigen::Matrix3d D = Eigen::Matrix3d::Zero();
+    D.topLeftCorner<2, 2>() << -c, s, -s, -c;
+    D(2, 2) = -1.0;
+    return D;
+  }
+  /// G with plus(x, d + e) = plus(plus(x, d), G e) to first order: [I -J d_p; 0 1].
+  static Eigen::Matrix3d plus_jacobian(const Point&, const Tangent& d) {
+    Eigen::Matrix3d G = Eigen::Matrix3d::Identity();
+    G(0, 2) = d(1);
+    G(1, 2) = -d(0);
+    return G;
+  }
   /// The inverse of to_additive(x).
   static Eigen::Matrix3d from_additive(const Point& x) {
     Eigen::Matrix3d T = Eigen::Matrix3d::Identity();

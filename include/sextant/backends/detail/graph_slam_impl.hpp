@@ -156,15 +156,17 @@ void GraphSlam<Motion, Sensor>::require_factorizable_extension(const Eigen::Matr
 }
 
 /// The motion factor between poses k and k + 1: the model's own between() when it has one, else
-/// r = minus(x_k+1, g(x_k, u)) with J_from = -G, J_to = I and covariance R (thesis eqs. 60-61).
+/// r = minus(x_k+1, g(x_k, u)) with covariance R (thesis eqs. 60-61) and the Jacobians of minus:
+/// J_to = D1, J_from = D2 G (D1 = I, D2 = -I in an additive chart; core/state_space.hpp).
 template <class Motion, class Sensor>
 BetweenFactor<GraphSlam<Motion, Sensor>::X> GraphSlam<Motion, Sensor>::motion_factor(std::size_t k) const {
   if constexpr (HasBetweenFactor<Motion>) {
     return motion_.between(poses_[k], poses_[k + 1], motions_[k].u, motions_[k].dt);
   } else {
     const auto prediction = motion_.predict(poses_[k], motions_[k].u, motions_[k].dt);
-    return {Space::minus(poses_[k + 1], prediction.x), -prediction.J_x_x, Eigen::Matrix<double, X, X>::Identity(),
-            prediction.R};
+    const State& next = poses_[k + 1];
+    return {Space::minus(next, prediction.x), minus_jacobian_second<Space>(next, prediction.x) * prediction.J_x_x,
+            minus_jacobian_first<Space>(next, prediction.x), prediction.R};
   }
 }
 
@@ -185,12 +187,19 @@ auto GraphSlam<Motion, Sensor>::linearize(std::size_t pose_count) const -> Linea
   return sys;
 }
 
-/// The prior on the first pose, r = minus(x_0, mu_0) (eq. 64).
+/// The prior on the first pose, r = minus(x_0, mu_0) (eq. 64), its Jacobian D = d minus / d x_0
+/// (the identity in an additive chart, where the product below is skipped to keep every bit).
 template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::add_prior_factor(Linearization& sys) const {
   const Eigen::Matrix<double, X, 1> r0 = Space::minus(poses_[0], prior_.mean);
-  sys.pose_diagonal[0] += prior_information_;
-  sys.pose_rhs.template head<X>() -= prior_information_ * r0;
+  if constexpr (has_minus_jacobians_v<Space>) {
+    const Eigen::Matrix<double, X, X> D = minus_jacobian_first<Space>(poses_[0], prior_.mean);
+    sys.pose_diagonal[0] += D.transpose() * prior_information_ * D;
+    sys.pose_rhs.template head<X>() -= D.transpose() * (prior_information_ * r0);
+  } else {
+    sys.pose_diagonal[0] += prior_information_;
+    sys.pose_rhs.template head<X>() -= prior_information_ * r0;
+  }
   sys.cost += r0.dot(prior_information_ * r0);
 }
 
@@ -211,19 +220,29 @@ void GraphSlam<Motion, Sensor>::add_motion_factors(Linearization& sys) const {
 }
 
 /// The linear factors that marginalized landmarks left on their poses (remove_landmark), relinearized
-/// by the poses' moves since: b = eta - Lambda d, d = minus(x, linearization point).
+/// by the poses' moves since: b = eta - Lambda d, d = minus(x, linearization point), read in each
+/// pose's tangent through D = d minus / d x (block-diagonal; the identity in an additive chart).
 template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::add_marginal_factors(Linearization& sys) const {
   for (const auto& factor : linear_factors_) {
     if (*std::max_element(factor.poses.begin(), factor.poses.end()) >= sys.pose_count) continue;
-    Eigen::VectorXd d(X * static_cast<Eigen::Index>(factor.poses.size()));
-    for (std::size_t i = 0; i < factor.poses.size(); ++i)
+    const std::size_t count = factor.poses.size();
+    Eigen::VectorXd d(X * static_cast<Eigen::Index>(count));
+    for (std::size_t i = 0; i < count; ++i)
       d.template segment<X>(X * i) = Space::minus(poses_[factor.poses[i]], factor.linearization[i]);
-    const Eigen::VectorXd b = factor.eta - factor.Lambda * d;
-    for (std::size_t i = 0; i < factor.poses.size(); ++i) {
+    Eigen::VectorXd b = factor.eta - factor.Lambda * d;
+    Eigen::MatrixXd Lambda = factor.Lambda;
+    if constexpr (has_minus_jacobians_v<Space>) {
+      Eigen::MatrixXd D = Eigen::MatrixXd::Zero(d.size(), d.size());
+      for (std::size_t i = 0; i < count; ++i)
+        D.template block<X, X>(X * i, X * i) = minus_jacobian_first<Space>(poses_[factor.poses[i]], factor.linearization[i]);
+      b = (D.transpose() * b).eval();
+      Lambda = (D.transpose() * factor.Lambda * D).eval();
+    }
+    for (std::size_t i = 0; i < count; ++i) {
       sys.pose_rhs.template segment<X>(X * factor.poses[i]) += b.template segment<X>(X * i);
-      for (std::size_t k = 0; k < factor.poses.size(); ++k) {
-        const Eigen::Matrix<double, X, X> block = factor.Lambda.template block<X, X>(X * i, X * k);
+      for (std::size_t k = 0; k < count; ++k) {
+        const Eigen::Matrix<double, X, X> block = Lambda.template block<X, X>(X * i, X * k);
         if (factor.poses[i] == factor.poses[k])
           sys.pose_diagonal[factor.poses[i]] += block;
         else if (factor.poses[i] < factor.poses[k])
