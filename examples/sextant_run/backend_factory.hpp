@@ -4,6 +4,8 @@
 // and hands it to the caller. Every data-set family goes through it (experiments.hpp, run_globe.cpp,
 // run_vislam.cpp); a family that runs a back-end twice (SEIF per active-set size, the EKF with and
 // without first-estimate Jacobians) lists two choices.
+#include <optional>
+#include <sextant/core/error.hpp>
 #include <sextant/models/se2_world_frame.hpp>
 #include <string>
 #include <type_traits>
@@ -47,6 +49,29 @@ std::vector<BackendChoice> backend_choices(const std::vector<BackendKind>& kinds
     choices.push_back(std::move(choice));
   }
   return choices;
+}
+
+/// Calls run(); a sextant::error it throws (a back-end failing as a whole: its options, its final
+/// optimization) comes back as its message, so that the caller reports it in that back-end's row and
+/// goes on with the others.
+template <class Run>
+std::optional<std::string> failure_of(Run&& run) {
+  try {
+    run();
+    return std::nullopt;
+  } catch (const error& e) {
+    return std::string(e.what());
+  }
+}
+
+/// A family's run record (key, label, failure) for a back-end that failed as a whole.
+template <class FamilyRun>
+FamilyRun failed_run(const BackendChoice& choice, std::string why) {
+  FamilyRun out;
+  out.key = choice.key;
+  out.label = choice.label;
+  out.failure = std::move(why);
+  return out;
 }
 
 /// Builds the back-end `choice` names over the models and the prior and calls use(backend).

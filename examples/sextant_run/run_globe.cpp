@@ -165,20 +165,17 @@ std::vector<BackendChoice> globe_choices(const std::vector<BackendKind>& kinds, 
 
 std::vector<GlobeRun> run_backends(const Dataset& data, const std::vector<BackendKind>& kinds, const RunnerConfig& c) {
   std::vector<GlobeRun> runs;
-  for (const auto& choice : globe_choices(kinds, c)) try {
+  for (const auto& choice : globe_choices(kinds, c)) {
+    const auto failure = failure_of([&] {
       with_backend(choice, data.motion, data.sensor, data.prior, [&](auto& backend) {
         if constexpr (requires { backend.optimize(); })
           runs.push_back(run_graph(backend, data, c, choice.key, choice.label));
         else
           runs.push_back(run_filter(backend, data, c, choice.key, choice.label));
       });
-    } catch (const error& e) {  // the back-end as a whole: its row says so, the others still run
-      GlobeRun failed;
-      failed.key = choice.key;
-      failed.label = choice.label;
-      failed.failure = e.what();
-      runs.push_back(std::move(failed));
-    }
+    });
+    if (failure) runs.push_back(failed_run<GlobeRun>(choice, *failure));  // its row says so; the others still run
+  }
   return runs;
 }
 

@@ -312,6 +312,10 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.ekf_first_estimates = parse_first_estimates(v); }},
       {"ekf", "gate_probability", "0", "Mahalanobis gate: reject observations above this chi-square quantile; 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.ekf.gate_probability = parse_gate_probability(v); }},
+      {"ekf", "tangent_reset", "false",
+       "re-read P in the tangent at the corrected pose (G P G^T; SE(3) and world-frame SE(2) only): the error-state "
+       "filter's reset, off because it fights first-estimate Jacobians (docs/derivations/state_space_jacobians.md)",
+       [](RunnerConfig& c, const std::string& v) { c.ekf.tangent_reset = parse_bool(v); }},
       {"seif", "first_estimate_jacobians", "auto",
        "auto (on where the pose is perturbed in the world frame: MRCLAM) | true | false",
        [](RunnerConfig& c, const std::string& v) { c.seif_first_estimates = parse_first_estimates(v); }},

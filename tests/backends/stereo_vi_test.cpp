@@ -184,5 +184,29 @@ TEST(StereoVi, ThePoolDoesNotCountAnUnusableNewLandmarkAsAdded) {
   EXPECT_EQ(policy.history()[0].in_pool, ekf.num_landmarks());
 }
 
+/// EkfOptions::tangent_reset: the correction is the same; the pose covariance after it is the one
+/// without the reset read in the tangent at the corrected pose, G P G^T with G = plus_jacobian.
+TEST(StereoVi, TheTangentResetReadsTheCovarianceAtTheCorrectedPose) {
+  const auto data = sim::simulate_stereo_vi({.seed = 3});
+  Ekf plain(data.motion, data.sensor, data.prior, {});
+  Ekf reset(data.motion, data.sensor, data.prior, {.tangent_reset = true});
+  for (const auto& step : data.steps) {
+    plain.predict(step.control, step.dt);
+    reset.predict(step.control, step.dt);
+    const Eigen::Matrix4d before = plain.pose().mean;
+    const auto result = plain.update(step.observations);
+    reset.update(step.observations);
+    if (result.corrected == 0) continue;
+    const Eigen::Matrix4d after = plain.pose().mean;
+    EXPECT_EQ(after, reset.pose().mean);
+    const se3::Matrix6d G = Se3Space::plus_jacobian(before, Se3Space::minus(after, before));
+    const se3::Matrix6d expected = G * plain.pose().cov * G.transpose();
+    EXPECT_GT((G - se3::Matrix6d::Identity()).norm(), 0.0);
+    EXPECT_LT((reset.pose().cov - expected).norm(), 1e-12 * expected.norm());
+    return;
+  }
+  FAIL() << "no step corrected a known landmark";
+}
+
 }  // namespace
 }  // namespace sextant

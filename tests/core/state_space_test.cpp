@@ -106,8 +106,9 @@ TEST(StateSpaceJacobians, GroupSpacesDifferFromTheAdditiveFallback) {
   EXPECT_GT((Se3Space::minus_jacobian_first(a, Eigen::Matrix4d::Identity()) - se3::Matrix6d::Identity()).norm(), 0.1);
   EXPECT_GT((Se2WorldSpace::plus_jacobian(Eigen::Vector3d(4, 5, 0), Eigen::Vector3d(1, 2, 0.3)) -
              Eigen::Matrix3d::Identity()).norm(), 1.0);
-  static_assert(has_plus_jacobian_v<Se3Space> && has_plus_jacobian_v<Se2WorldSpace>);
-  static_assert(!has_plus_jacobian_v<Se2Space> && !has_plus_jacobian_v<EuclideanSpace<2>>);
+  static_assert(has_plus_jacobian_v<Se3Space, Eigen::Matrix4d> && has_plus_jacobian_v<Se2WorldSpace, Eigen::Vector3d>);
+  static_assert(!has_plus_jacobian_v<Se2Space, Eigen::Vector3d> && !has_plus_jacobian_v<EuclideanSpace<2>, Eigen::Vector2d>);
+  static_assert(has_minus_jacobians_v<Se3Space, Eigen::Matrix4d> && !has_minus_jacobians_v<Se2Space, Eigen::Vector3d>);
 }
 
 }  // namespace

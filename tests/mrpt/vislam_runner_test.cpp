@@ -139,4 +139,24 @@ TEST_F(VislamRunner, ACleanTwinWithOtherFramesIsNamedNotSilentlyDropped) {
       << r.out;
 }
 
+TEST_F(VislamRunner, ACleanTwinWithShiftedTimeStampsIsUsedWithAWarning) {
+  // Issue 36: a NAME_clean.npz whose time stamps are 1000 s off was used as the reference without a word.
+  const auto noisy = sextant::test::shared_data("ece276a/0027_noisy.npz");
+  const auto clean = sextant::test::shared_data("ece276a/0027_clean.npz");
+  SEXTANT_REQUIRE_DATA(noisy);
+  SEXTANT_REQUIRE_DATA(clean);
+  fs::copy_file(noisy, dir / "shifted_noisy.npz");
+  // numpy comes with python3-matplotlib (cmake/install_deps.sh), as for the fuzzers' seeds.
+  const auto shift = run_program("/usr/bin/python3 -c \"import numpy as np; d = dict(np.load('" + clean +
+                                     "')); d['time_stamps'] = d['time_stamps'] + 1000.0; np.savez('" +
+                                     (dir / "shifted_clean.npz").string() + "', **d)\"",
+                                 dir);
+  if (shift.exit_code != 0) GTEST_SKIP() << "numpy could not write the shifted copy: " << shift.err;
+  const auto r = run_program(std::string(SEXTANT_VISLAM_EXE) + " -b ekf -d " + (dir / "shifted_noisy.npz").string(), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("warning: the time stamps of shifted_clean.npz differ from those of shifted_noisy.npz by up to 1000 s"),
+            std::string::npos)
+      << r.out;
+}
+
 }  // namespace

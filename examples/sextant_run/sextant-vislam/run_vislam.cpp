@@ -190,7 +190,8 @@ std::vector<BackendChoice> vislam_choices(const std::vector<BackendKind>& kinds,
 
 std::vector<ViRun> run_all(const ViData& d, const std::vector<BackendKind>& kinds, const RunnerConfig& c) {
   std::vector<ViRun> runs{dead_reckoning_row(d)};
-  for (const auto& choice : vislam_choices(kinds, c)) try {
+  for (const auto& choice : vislam_choices(kinds, c)) {
+    const auto failure = failure_of([&] {
       with_backend(choice, d.motion, d.sensor, d.prior, [&](auto& backend) {
         if constexpr (requires { backend.optimize(); })
           runs.push_back(run_graph(backend, d, choice.key, choice.label));
@@ -198,13 +199,9 @@ std::vector<ViRun> run_all(const ViData& d, const std::vector<BackendKind>& kind
           runs.push_back(run_backend(backend, d, c.vislam.pool, choice.kind == BackendKind::ekf ? 1 : 10, choice.key,
                                      choice.label));
       });
-    } catch (const error& e) {  // the back-end as a whole: its row says so, the others still run
-      ViRun failed;
-      failed.key = choice.key;
-      failed.label = choice.label;
-      failed.failure = e.what();
-      runs.push_back(std::move(failed));
-    }
+    });
+    if (failure) runs.push_back(failed_run<ViRun>(choice, *failure));  // its row says so; the others still run
+  }
   return runs;
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sextant/core/backend_types.hpp"
+#include "sextant/core/state_space.hpp"
 #include "sextant/core/landmark_store.hpp"
 #include "sextant/core/rollback_guard.hpp"
 #include "sextant/core/concepts.hpp"
@@ -44,6 +45,12 @@ struct EkfOptions {
   /// perturbed in the world frame), every H then shares one null space and the filter gains no
   /// information about the unobservable global pose (docs/results/vislam.md). Off: the textbook EKF.
   bool first_estimate_jacobians = false;
+  /// The error-state filter's reset: after a correction delta, P is read in the tangent at the new
+  /// robot state, P_x -> G P_x G^T with G = plus_jacobian(x, delta) (docs/derivations/
+  /// state_space_jacobians.md); a no-op for additive charts. Off by default: it moves the pose part
+  /// of the unobservable subspace that first-estimate Jacobians keep fixed, and measured it costs
+  /// more than it brings (MRCLAM world chart with first estimates: 0.28-0.45 m -> 0.40-4.5 m).
+  bool tangent_reset = false;
 };
 
 /// EKF-SLAM: joint Gaussian over the robot state and a growing set of landmarks. Only the lower
@@ -105,6 +112,10 @@ class EkfSlam {
     State x;                   ///< plus(x, delta_x), the corrected robot state
     Eigen::MatrixXd W;         ///< symmetric form: L^-1 C^T (Zk x n), P' = P - W^T W
     Eigen::MatrixXd P_joseph;  ///< Joseph form: the whole corrected P
+    /// G = plus_jacobian(x, delta_x): the corrected P, held in the tangent at the old x, is read at
+    /// the new one as G P G^T on the robot's rows (docs/derivations/state_space_jacobians.md); none
+    /// for an additive chart, where G = I.
+    std::optional<Eigen::Matrix<double, X, X>> reset;
   };
 
   static Eigen::Index offset_of(std::size_t slot) { return LandmarkStore<M>::template offset_of<X>(slot); }
@@ -132,6 +143,8 @@ class EkfSlam {
   Plan plan(std::span<const ObservationType> known, std::span<const ObservationType> fresh, UpdateResult& result) const;
   void commit(const Plan& plan);
   void apply(const Correction& correction);
+  template <class Lower>
+  static void reset_robot_tangent(Lower& P, const Eigen::Matrix<double, X, X>& G);
   void augment(LandmarkId id, const Init& init);
 
   Motion motion_;

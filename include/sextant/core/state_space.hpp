@@ -70,13 +70,11 @@ TangentJacobian<Space, Point> plus_jacobian(const Point& x, const Tangent& d) {
 }
 
 /// Whether minus_jacobian_first<Space> can differ from the identity (the space defines it).
-template <class Space>
-inline constexpr bool has_minus_jacobians_v =
-    requires(const typename Space::Point& a) { Space::minus_jacobian_first(a, a); };
+template <class Space, class Point>
+inline constexpr bool has_minus_jacobians_v = requires(const Point& a) { Space::minus_jacobian_first(a, a); };
 
 /// Whether plus_jacobian<Space> can differ from the identity (the space defines it).
-template <class Space>
-inline constexpr bool has_plus_jacobian_v =
-    requires(const typename Space::Point& x, const typename Space::Tangent& d) { Space::plus_jacobian(x, d); };
+template <class Space, class Point>
+inline constexpr bool has_plus_jacobian_v = requires(const Point& x) { Space::plus_jacobian(x, Space::minus(x, x)); };
 
 }  // namespace sextant

@@ -121,6 +121,11 @@ auto EkfSlam<Motion, Sensor>::compute_correction(const std::vector<Linearized>& 
   if (!out.delta.allFinite()) throw numerical_error("EKF correction is not finite");
   out.x = Space::plus(x_, out.delta.template head<X>());
   if (!Space::is_finite(out.x)) throw numerical_error("EKF correction of the robot state is not finite");
+  if constexpr (has_plus_jacobian_v<Space, State>) {
+    if (options_.tangent_reset)
+      out.reset = plus_jacobian<Space>(x_, Eigen::Matrix<double, X, 1>(out.delta.template head<X>()));
+    if (out.reset && !out.reset->allFinite()) throw numerical_error("EKF covariance reset is not finite");
+  }
   if (options_.covariance_update == CovarianceUpdate::symmetric) {
     out.W = llt.matrixL().solve(C.transpose());
     // |(W^T W)_ij| <= max_i |W_i|^2: with that and |P| below half the double range, P - W^T W is finite.
@@ -175,6 +180,17 @@ Eigen::MatrixXd EkfSlam<Motion, Sensor>::joseph_covariance(const std::vector<Lin
   return symmetrized(A);
 }
 
+/// P's robot rows and columns (lower triangle) read in the tangent at the corrected robot state:
+/// P_xx -> G P_xx G^T, P_mx -> P_mx G^T. O(n X^2).
+template <class Motion, class Sensor>
+template <class Lower>
+void EkfSlam<Motion, Sensor>::reset_robot_tangent(Lower& P, const Eigen::Matrix<double, X, X>& G) {
+  const Eigen::Index below = P.rows() - X;
+  const Eigen::Matrix<double, X, X> P_xx = symmetric_diagonal_block<X>(P, 0);
+  P.template topLeftCorner<X, X>().template triangularView<Eigen::Lower>() = symmetrized(G * P_xx * G.transpose());
+  if (below > 0) P.bottomLeftCorner(below, X) = (P.bottomLeftCorner(below, X) * G.transpose()).eval();
+}
+
 /// Commits a planned correction: nothing here can fail.
 template <class Motion, class Sensor>
 void EkfSlam<Motion, Sensor>::apply(const Correction& correction) {
@@ -183,6 +199,7 @@ void EkfSlam<Motion, Sensor>::apply(const Correction& correction) {
     subtract_gram_lower(P, correction.W);
   else
     P.template triangularView<Eigen::Lower>() = correction.P_joseph;
+  if (correction.reset) reset_robot_tangent(P, *correction.reset);
   x_ = correction.x;
   landmarks_.means().stacked() += correction.delta.tail(correction.delta.size() - X);
 }

@@ -192,7 +192,7 @@ auto GraphSlam<Motion, Sensor>::linearize(std::size_t pose_count) const -> Linea
 template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::add_prior_factor(Linearization& sys) const {
   const Eigen::Matrix<double, X, 1> r0 = Space::minus(poses_[0], prior_.mean);
-  if constexpr (has_minus_jacobians_v<Space>) {
+  if constexpr (has_minus_jacobians_v<Space, State>) {
     const Eigen::Matrix<double, X, X> D = minus_jacobian_first<Space>(poses_[0], prior_.mean);
     sys.pose_diagonal[0] += D.transpose() * prior_information_ * D;
     sys.pose_rhs.template head<X>() -= D.transpose() * (prior_information_ * r0);
@@ -232,7 +232,7 @@ void GraphSlam<Motion, Sensor>::add_marginal_factors(Linearization& sys) const {
       d.template segment<X>(X * i) = Space::minus(poses_[factor.poses[i]], factor.linearization[i]);
     Eigen::VectorXd b = factor.eta - factor.Lambda * d;
     Eigen::MatrixXd Lambda = factor.Lambda;
-    if constexpr (has_minus_jacobians_v<Space>) {
+    if constexpr (has_minus_jacobians_v<Space, State>) {
       Eigen::MatrixXd D = Eigen::MatrixXd::Zero(d.size(), d.size());
       for (std::size_t i = 0; i < count; ++i)
         D.template block<X, X>(X * i, X * i) = minus_jacobian_first<Space>(poses_[factor.poses[i]], factor.linearization[i]);
