@@ -87,6 +87,11 @@ struct RunnerConfig {
   VislamSettings vislam;
   io::MrclamOptions mrclam;
   bool mrclam_filters_in_world_frame = true;  ///< [mrclam] filters_in_world_frame
+  /// [mrclam] gate_probability and graph_robust_kernel: what docs/results/mrclam.md recommends for
+  /// real robots (heavy-tailed outliers), set on the back-ends for MRCLAM runs whatever [ekf], [seif],
+  /// [fastslam] gate_probability and [graph] robust_kernel say.
+  double mrclam_gate_probability = 0.9999;
+  RobustKernel mrclam_graph_kernel = RobustKernel::cauchy;
   AssociationSettings association;
   double scene_quantile = 3.0;
 };
@@ -280,6 +285,14 @@ inline const std::vector<ConfigKey>& config_keys() {
          if (values.size() != 6 || std::any_of(values.begin(), values.end(), [](double a) { return a < 0.0; }))
            throw invalid_input_error("'" + v + "' must be six non-negative numbers");
          std::copy(values.begin(), values.end(), c.mrclam.motion.alpha.begin());
+       }},
+      {"mrclam", "gate_probability", "0.9999",
+       "MRCLAM: Mahalanobis gate of EKF, SEIF and FastSLAM (real data has outliers; 0 = off); overrides their own",
+       [](RunnerConfig& c, const std::string& v) { c.mrclam_gate_probability = parse_gate_probability(v); }},
+      {"mrclam", "graph_robust_kernel", "cauchy", "MRCLAM: GraphSLAM's robust kernel (none | huber | cauchy); overrides [graph]",
+       [](RunnerConfig& c, const std::string& v) {
+         c.mrclam_graph_kernel = parse_choice<RobustKernel>(
+             v, {{"none", RobustKernel::none}, {"huber", RobustKernel::huber}, {"cauchy", RobustKernel::cauchy}});
        }},
       {"mrclam", "filters_in_world_frame", "true",
        "MRCLAM: EKF and SEIF perturb the pose in the world frame (with the EKF's first-estimate Jacobians: no "

@@ -103,6 +103,7 @@ inline void write_summary_json(const std::string& path, const std::vector<TableR
     out << "  {\"dataset\": \"" << json_escaped(rows[i].dataset) << "\", \"backend\": \"" << rows[i].backend
         << "\", \"label\": \"" << json_escaped(rows[i].label) << "\", \"runs\": " << rows[i].runs << ", \"pose_mae\": " << json_number(s.pose_mae)
         << ", \"map_mae\": " << json_number(s.map_mae) << ", \"pose_mae_aligned\": " << json_number(s.pose_mae_aligned)
+        << ", \"pose_rmse\": " << json_number(s.pose_rmse) << ", \"pose_rmse_aligned\": " << json_number(s.pose_rmse_aligned)
         << ", \"map_mae_aligned\": " << json_number(s.map_mae_aligned) << ", \"pose_nees_inside\": " << json_number(s.pose_nees_inside)
         << ", \"map_nees_inside\": " << json_number(s.map_nees_inside) << ", \"pose_anees\": " << json_number(s.pose_anees)
         << ", \"total_seconds\": " << json_number(s.total_seconds)

@@ -4,15 +4,20 @@
 // filter may know the robot's heading better than its prior does.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <numbers>
 #include <map>
 #include <random>
+#include <set>
 
 #include "../support/shared_data.hpp"
 #include "sextant/backends/ekf_slam.hpp"
 #include "sextant/backends/seif_slam.hpp"
 #include "sextant/core/landmark_init.hpp"
+#include "sextant/eval/alignment.hpp"
 #include "sextant/eval/dead_reckoning.hpp"
+#include "sextant/eval/metrics.hpp"
 #include "sextant/io/mrclam_reader.hpp"
 #include "sextant/models/range_bearing_2d.hpp"
 #include "sextant/models/se2_world_frame.hpp"
@@ -215,6 +220,95 @@ TEST(PlanarFirstEstimates, OnMrclamTheWorldFrameSeifBeatsHalfOfDeadReckoning) {
         WorldMotion(data.motion), WorldSensor(data.sensor), in_world_frame(data.prior),
         {.max_active = 8, .gate_probability = 0.9999, .first_estimate_jacobians = true});
     EXPECT_LT(position_rmse(seif, data), 0.5 * dead_reckoning_rmse(data)) << "robot " << robot;
+  }
+}
+
+/// What a stress run of the world-chart EKF reports: position RMSE after rigid alignment to Vicon
+/// (aligned on the steps from `scored_from` seconds on, and scored on them), the updates that failed, and the smallest ratio
+/// lambda_min(P) / lambda_max(P) over the steps.
+struct StressRun {
+  double aligned_rmse = 0.0;
+  std::size_t failed_updates = 0;
+  double worst_eigenvalue_ratio = 1.0;
+};
+
+/// The EKF as sextant-run runs it on MRCLAM (world chart, first estimates, 0.9999 gate), with P's
+/// spectrum checked after every step; a failed update is counted and the run goes on.
+StressRun world_ekf_stress_run(const io::MrclamRun& data, double scored_from) {
+  using WorldMotion = InWorldFrame<Unicycle>;
+  using WorldSensor = SeenInWorldFrame<RangeBearing2D>;
+  EkfSlam<WorldMotion, WorldSensor> ekf(WorldMotion(data.motion), WorldSensor(data.sensor), in_world_frame(data.prior),
+                                        {.gate_probability = 0.9999, .first_estimate_jacobians = true});
+  StressRun out;
+  std::vector<Eigen::Vector2d> estimate, truth;
+  for (std::size_t k = 0; k < data.steps.size(); ++k) {
+    ekf.predict(data.steps[k].control, data.steps[k].dt);
+    try {
+      ekf.update(data.steps[k].observations);
+    } catch (const error&) {
+      ++out.failed_updates;
+    }
+    const Eigen::VectorXd eigenvalues =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(ekf.covariance(), Eigen::EigenvaluesOnly).eigenvalues();
+    out.worst_eigenvalue_ratio = std::min(out.worst_eigenvalue_ratio, eigenvalues.minCoeff() / eigenvalues.maxCoeff());
+    if (data.step_times[k] < scored_from) continue;
+    estimate.push_back(ekf.pose().mean.head<2>());
+    truth.push_back(data.true_poses[k + 1].head<2>());
+  }
+  out.aligned_rmse = eval::rms(eval::aligned_errors<2>(estimate, truth));
+  return out;
+}
+
+/// Issue 35's stress cases, built from Dataset6.
+/// A burst of outliers: from `from` seconds on, the next `count` sightings turned by 1.5 rad and
+/// 1.5 times as far.
+io::MrclamRun with_outlier_burst(io::MrclamRun data, double from, int count) {
+  for (std::size_t k = 0; k < data.steps.size() && count > 0; ++k) {
+    if (data.step_times[k] < from) continue;
+    for (auto& o : data.steps[k].observations) {
+      if (count-- <= 0) break;
+      o.z(0) *= 1.5;
+      o.z(1) = wrap_angle(o.z(1) + 1.5);
+    }
+  }
+  return data;
+}
+/// Wrong first estimates: every landmark's first sighting 0.5 m too far (over 3 of its range sigmas).
+io::MrclamRun with_far_first_sightings(io::MrclamRun data) {
+  std::set<LandmarkId> seen;
+  for (auto& step : data.steps)
+    for (auto& o : step.observations)
+      if (seen.insert(o.landmark_id).second) o.z(0) += 0.5;
+  return data;
+}
+
+/// The world-chart EKF on Dataset6 with a burst of 30 outliers and with wrong first estimates: no
+/// update fails, P stays positive semi-definite (lambda_min / lambda_max above -1e-12: rounding),
+/// and the aligned position RMSE stays within 2x the clean run's (issue 35's bound). Measured
+/// 2026-11-25: burst 1.00-1.78x (robot 4), first estimates 0.92-1.10x, smallest eigenvalue ratio of
+/// P 2e-7. The third case, a minute without sightings, is not here: robots 1-3 do not recover from
+/// it (docs/results/mrclam.md, "Stress cases").
+TEST(PlanarFirstEstimates, OnMrclamTheWorldFrameEkfSurvivesOutlierBurstsAndWrongFirstEstimates) {
+  const std::string dir = test::shared_data("mrclam/MRCLAM_Dataset6");
+  SEXTANT_REQUIRE_DATA(dir);
+  for (int robot = 1; robot <= 5; ++robot) {
+    const auto data = io::read_mrclam(dir, robot, {.odometry_delay = 0.2});
+    struct Case {
+      const char* name;
+      io::MrclamRun data;
+      double scored_from;
+    };
+    const Case cases[] = {{"a burst of 30 outliers", with_outlier_burst(data, 400.0, 30), 0.0},
+                          {"first sightings 0.5 m too far", with_far_first_sightings(data), 0.0}};
+    for (const auto& c : cases) {
+      const StressRun clean = world_ekf_stress_run(data, c.scored_from), run = world_ekf_stress_run(c.data, c.scored_from);
+      EXPECT_EQ(run.failed_updates, 0u) << "robot " << robot << ", " << c.name;
+      EXPECT_GT(run.worst_eigenvalue_ratio, -1e-12) << "robot " << robot << ", " << c.name;
+      EXPECT_LE(run.aligned_rmse, 2.0 * clean.aligned_rmse) << "robot " << robot << ", " << c.name;
+      std::printf("robot %d, %-30s aligned RMSE %.3f m, clean %.3f m (%.2fx); smallest eigenvalue ratio of P %.2e\n",
+                  robot, c.name, run.aligned_rmse, clean.aligned_rmse, run.aligned_rmse / clean.aligned_rmse,
+                  run.worst_eigenvalue_ratio);
+    }
   }
 }
 

@@ -180,6 +180,7 @@ RunSummary<typename Backend::State> evaluate_smoothed_run(Backend& backend, cons
 struct Summary {
   double pose_mae = 0.0, map_mae = 0.0, map_mae_over_time = 0.0;
   double pose_rmse = 0.0;  ///< root mean square of the position error over the steps, averaged over runs
+  double pose_rmse_aligned = 0.0;  ///< the same after rigid alignment of the trajectory to the truth (evo's APE)
   double pose_mae_aligned = 0.0, map_mae_aligned = 0.0;  ///< after rigid alignment to the truth
   double pose_nees_inside = 0.0, map_nees_inside = 0.0;  ///< fractions in [0, 1]
   double total_seconds = 0.0, seconds_per_step = 0.0;
@@ -193,7 +194,7 @@ struct Summary {
   /// Marks every score NaN (a run without ground truth has only its time).
   void mark_unscored() {
     constexpr double none = std::numeric_limits<double>::quiet_NaN();
-    pose_mae = map_mae = map_mae_over_time = pose_rmse = pose_mae_aligned = map_mae_aligned = none;
+    pose_mae = map_mae = map_mae_over_time = pose_rmse = pose_rmse_aligned = pose_mae_aligned = map_mae_aligned = none;
     pose_nees_inside = map_nees_inside = pose_anees = pose_mae_std = map_mae_std = none;
     anees_interval.reset();
   }
@@ -208,6 +209,7 @@ Summary summarize(const std::vector<RunSummary<State>>& runs, int pose_dof, int 
   for (const auto& r : runs) {
     pose_maes.push_back(mean(r.pose_error));
     s.pose_rmse += rms(r.pose_error) / n;
+    s.pose_rmse_aligned += rms(r.pose_error_aligned) / n;
     map_maes.push_back(mean(r.map_error));
     s.pose_nees_inside += fraction_at_most(r.pose_nees, nees_upper_bound(pose_dof, confidence)) / n;
     s.map_nees_inside += fraction_at_most(r.map_nees, nees_upper_bound(landmark_dof, confidence)) / n;
