@@ -8,6 +8,7 @@
 #include <limits>
 #include <optional>
 #include <sextant/eval/experiment.hpp>
+#include <sextant/io/implausible_values.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -42,6 +43,11 @@ inline std::string cell(const char* format, double value) {
   char text[32];
   std::snprintf(text, sizeof text, format, value);
   return text;
+}
+
+/// The reader's warnings about implausible values, one line each (io::ImplausibleValues).
+inline void print_warnings(const io::ImplausibleValues& implausible) {
+  for (const auto& line : implausible.warnings()) std::printf("%s\n", line.c_str());
 }
 
 /// A row's second line when some of its steps failed and were skipped (eval::StepErrors::skip).

@@ -66,6 +66,23 @@ TEST(IsamReader, ReadsCovarianceRecordsAndObservationsOfTheFirstPose) {
   }
 }
 
+TEST(IsamReader, ImplausibleStepsAndLandmarkDistancesAreUsedAndListedWithFileAndLine) {
+  // Issue 36: an odometry step of kilometres or a landmark a kilometre away is legal but no ground
+  // vehicle's; it is read and listed, the first five in full and a count of the rest.
+  std::string text = "EDGE2 0 1 1 0 0 50 0 0 50 0 100\nLANDMARK 1 7 2000 0 10 0 10\n";
+  for (int k = 1; k <= 6; ++k)
+    text += "EDGE2 " + std::to_string(k) + " " + std::to_string(k + 1) + " 300 0 0 50 0 0 50 0 100\n";
+  const auto path = write_file("implausible", text);
+  const auto data = read_isam_2d(path, IsamNoise::square_root_information);
+  EXPECT_EQ(data.steps.size(), 7u);
+  EXPECT_EQ(data.implausible.count, 7u);
+  const auto warnings = data.implausible.warnings();
+  ASSERT_EQ(warnings.size(), 6u);
+  EXPECT_EQ(warnings[0], "warning: " + path + ":2: landmark at a distance of 2000 m is beyond the plausible 1000 m (used as given)");
+  EXPECT_EQ(warnings[1], "warning: " + path + ":3: odometry step of 300 m is beyond the plausible 100 m (used as given)");
+  EXPECT_EQ(warnings[5], "warning: and 2 more implausible values");
+}
+
 TEST(IsamReader, GroundTruthComposesOdometryAndLandmarks) {
   const auto path = write_file("truth", "EDGE2 0 1 1 0 1.5707963267948966 50 0 0 50 0 100\n"
                                         "LANDMARK 1 3 2 0 10 0 10\n");

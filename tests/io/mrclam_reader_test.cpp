@@ -70,6 +70,23 @@ TEST_F(MrclamFiles, DropsRobotsUnknownBarcodesAndRepeatsAndCountsThem) {
   EXPECT_EQ(run.true_landmarks.size(), 2u);
 }
 
+TEST_F(MrclamFiles, ImplausibleVelocitiesAndRangesAreUsedAndListedWithFileAndLine) {
+  // Issue 36: legal numbers that no small robot or camera gives (50 m/s, 20 rad/s, a 90 m range)
+  // were used without a word.
+  EXPECT_EQ(read_mrclam(dir_.string(), 1).implausible.count, 0u);  // the plain files: nothing to say
+  write("Robot1_Odometry.dat", "# t v w\n100.0 50.0 0.0\n100.5 1.0 20.0\n101.0 0.5 0.2\n103.0 0.0 0.0\n");
+  write("Robot1_Measurement.dat", "# t barcode r b\n100.3 63 90.0 0.3\n101.1 81 4.0 -0.5\n");
+  const auto run = read_mrclam(dir_.string(), 1);
+  EXPECT_EQ(run.counts.measurements, 2u);  // used as given
+  EXPECT_EQ(run.implausible.count, 3u);
+  const auto warnings = run.implausible.warnings();
+  ASSERT_EQ(warnings.size(), 3u);
+  const std::string odometry = (dir_ / "Robot1_Odometry.dat").string(), measurements = (dir_ / "Robot1_Measurement.dat").string();
+  EXPECT_EQ(warnings[0], "warning: " + odometry + ":2: speed 50 m/s is beyond the plausible 2 m/s (used as given)");
+  EXPECT_EQ(warnings[1], "warning: " + odometry + ":3: turn rate 20 rad/s is beyond the plausible 6.28319 rad/s (used as given)");
+  EXPECT_EQ(warnings[2], "warning: " + measurements + ":2: range 90 m is beyond the plausible 30 m (used as given)");
+}
+
 TEST_F(MrclamFiles, MalformedFilesNameFileAndLine) {
   const auto message = [&] {
     try {

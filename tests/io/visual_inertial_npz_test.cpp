@@ -230,6 +230,21 @@ TEST_F(NpzFiles, AnImuTCamInForwardRightDownAxesIsRebasedOntoTheVelocitiesAxes) 
   EXPECT_TRUE((as_stored.cam_T_imu * Eigen::Vector4d(1.5, -0.1, 0.6, 1.0)).isApprox(Eigen::Vector4d(0, 0, 0, 1), 1e-12));
 }
 
+TEST_F(NpzFiles, ImplausibleVelocitiesAreUsedAndListedWithFileAndFrame) {
+  // Issue 36: a legal but implausible velocity (500 m/s, 20 rad/s) was integrated without a word.
+  EXPECT_EQ(read_visual_inertial_npz(write_npz("small.npz", small_dataset())).implausible.count, 0u);
+  auto entries = small_dataset();
+  entries["linear_velocity"] = npy({1, 2, 3, 4, 500, 6, 7, 8, 9}, "(3, 3)");
+  entries["angular_velocity"] = npy({20, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9}, "(3, 3)");
+  const auto path = write_npz("fast.npz", entries);
+  const auto data = read_visual_inertial_npz(path);
+  EXPECT_EQ(data.steps[1].control(1), 500.0);  // used as given
+  const auto warnings = data.implausible.warnings();
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_EQ(warnings[0], "warning: " + path + ": frame 0: angular velocity 20 rad/s is beyond the plausible 6.28319 rad/s (used as given)");
+  EXPECT_EQ(warnings[1], "warning: " + path + ": frame 1: linear velocity 500 m/s is beyond the plausible 100 m/s (used as given)");
+}
+
 TEST_F(NpzFiles, ReadsTheOtherKeySpellingsAndTheCamTImuConvention) {
   auto entries = small_dataset();
   entries["rotational_velocity"] = entries["angular_velocity"];

@@ -18,6 +18,7 @@ std::vector<TableRow> run_isam(const CliOptions& cli, const std::string& path, c
   for (const auto& step : data.steps) sightings += step.observations.size();
   std::printf("\n%s: %zu steps, %zu landmark sightings%s\n", path.c_str(), data.steps.size(), sightings,
               data.has_ground_truth() ? "" : "; no ground truth beside it: the runs are timed and written out, not scored");
+  print_warnings(data.implausible);
   return run_dataset(cli.output, std::filesystem::path(path).filename().string(), data, kinds, config, "m");
 }
 

@@ -113,6 +113,7 @@ std::vector<TableRow> run_mrclam(const CliOptions& cli, const std::string& datas
     std::printf("\n%s: %zu landmark measurements used; dropped %zu sightings of robots, %zu unknown barcodes, %zu outside "
                 "the Vicon/odometry time span, %zu repeated at one time\n",
                 name.c_str(), c.measurements, c.robot_sightings, c.unknown_barcodes, c.outside_run, c.repeated_in_step);
+    print_warnings(data.implausible);
     print_dataset_header(name, data, "m");
     const auto [filters, others] = split_filters(kinds, config.mrclam_filters_in_world_frame);
     RunOptions plot_once = options;  // the plots of the directory are drawn after the second part

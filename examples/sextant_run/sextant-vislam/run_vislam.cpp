@@ -100,6 +100,7 @@ void use_clean_twin(ViData& d, const io::VisualInertialDataset& data, const io::
 
 ViData from_npz(const std::string& path, const RunnerConfig& c) {
   const auto data = io::read_visual_inertial_npz(path);
+  print_warnings(data.implausible);
   ViData d;
   d.name = std::filesystem::path(path).filename().string();
   const double v = c.vislam.velocity_sigma, w = c.vislam.rate_sigma;

@@ -52,6 +52,7 @@ inline IsamDataset read_isam_dataset(const std::string& path, std::optional<Isam
   const PlanarDataset data = read_isam_2d(path, noise);
   IsamDataset out;
   out.path = path;
+  out.implausible = data.implausible;
   out.sensor.Q = data.landmark_cov;
   out.prior = {Eigen::Vector3d::Zero(), prior_std * prior_std * Eigen::Matrix3d::Identity()};
   const bool still_step = !data.initial_observations.empty();

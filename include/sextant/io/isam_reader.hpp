@@ -18,6 +18,7 @@
 
 #include "sextant/core/error.hpp"
 #include "sextant/core/observation.hpp"
+#include "sextant/io/implausible_values.hpp"
 #include "sextant/io/input_file.hpp"
 #include "sextant/io/parse_number.hpp"
 #include "sextant/models/point_in_robot_frame_2d.hpp"
@@ -34,6 +35,14 @@ struct PlanarDataset {
   std::vector<Step<OdometryIncrement2D, Eigen::Vector2d>> steps;   ///< one per odometry record
   Eigen::Matrix2d landmark_cov = Eigen::Matrix2d::Identity();      ///< of every landmark record
   std::vector<long long> pose_ids;                                 ///< file id of pose k (k = 0 .. steps)
+  ImplausibleValues implausible;  ///< odometry steps and landmark distances beyond IsamPlausibility
+};
+
+/// Beyond these an iSAM record's value is used but listed as implausible: an odometry step's length
+/// in m (cityTrees10000's and Victoria Park's largest: 1.5) and a landmark's distance from its pose
+/// (largest 20.7).
+struct IsamPlausibility {
+  double step = 100.0, landmark_distance = 1000.0;
 };
 
 namespace detail {
@@ -141,6 +150,7 @@ class IsamDatasetBuilder {
                         "); loop-closure edges are not supported");
     OdometryIncrement2D u;
     u.delta << record.values[2], record.values[3], record.values[4];
+    data_.implausible.check(u.delta.head<2>().norm(), IsamPlausibility{}.step, record.where, "odometry step of", "m");
     u.cov = noise_covariance<3>({record.values.begin() + 5, record.values.end()}, form_, record.where);
     data_.steps.push_back({u, 1.0, {}});
     data_.pose_ids.push_back(to);
@@ -165,6 +175,8 @@ class IsamDatasetBuilder {
     if (!seen_from_current_pose_.insert(id).second)
       throw parse_error(record.where + ": landmark " + std::to_string(id) + " seen twice from pose " + std::to_string(pose));
     Observation<Eigen::Vector2d> observation{id, Eigen::Vector2d(record.values[2], record.values[3])};
+    data_.implausible.check(observation.z.norm(), IsamPlausibility{}.landmark_distance, record.where,
+                            "landmark at a distance of", "m");
     (data_.steps.empty() ? data_.initial_observations : data_.steps.back().observations).push_back(observation);
   }
 

@@ -8,6 +8,7 @@
 
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/observation.hpp"
+#include "sextant/io/implausible_values.hpp"
 
 namespace sextant::io {
 
@@ -36,6 +37,7 @@ struct LandmarkDataset {
   std::vector<State> true_poses;  ///< [k]: after step k, [0] the start; empty without ground truth
   std::map<LandmarkId, typename Sensor::Landmark> true_landmarks;
   LandmarkIds ids = LandmarkIds::measured;
+  ImplausibleValues implausible;  ///< legal values beyond the reader's plausible limits, for warnings
   bool has_ground_truth() const { return !true_poses.empty(); }
 };
 

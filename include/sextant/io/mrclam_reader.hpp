@@ -24,6 +24,7 @@
 #include "sextant/core/error.hpp"
 #include "sextant/core/observation.hpp"
 #include "sextant/core/state_space.hpp"
+#include "sextant/io/implausible_values.hpp"
 #include "sextant/io/landmark_dataset.hpp"
 #include "sextant/io/numeric_rows.hpp"
 #include "sextant/io/parse_number.hpp"
@@ -53,6 +54,10 @@ struct MrclamOptions {
   /// The most steps a run may be cut into (10^6 steps of 0.25 s are 69 hours; Dataset6's robots
   /// have about 27000); more is an error before any step is made.
   std::size_t max_steps = 1'000'000;
+  /// Beyond these a value is used but listed as implausible (MrclamRun::implausible): |v| in m/s
+  /// (Dataset6's largest 0.086; an iRobot Create drives at most 0.5), |w| in rad/s (largest 0.57),
+  /// a range in m (largest 8.6).
+  double plausible_speed = 2.0, plausible_rate = 6.283185307179586, plausible_range = 30.0;
 };
 
 struct MrclamCounts {
@@ -69,7 +74,7 @@ struct MrclamCounts {
 struct MrclamRun : LandmarkDataset<Unicycle, RangeBearing2D> {
   double start_time = 0.0;          ///< absolute time [s] of the initial pose
   std::vector<double> step_times;   ///< [s] end of each step, from start_time
-  MrclamCounts counts;
+  MrclamCounts counts;  ///< (`implausible`: velocities and ranges beyond MrclamOptions' plausible limits)
 };
 
 namespace detail {
@@ -223,6 +228,7 @@ inline void add_measurements(MrclamRun& run, const std::vector<TimedRow>& measur
       ++run.counts.repeated_in_step;
     } else {
       if (!(row.values[2] > 0.0)) throw parse_error(where + ": range must be positive");
+      run.implausible.check(row.values[2], options.plausible_range, where, "range", "m");
       run.steps.back().observations.push_back({barcode->second, Eigen::Vector2d(row.values[2], row.values[3])});
       ++run.counts.measurements;
     }
@@ -248,7 +254,12 @@ inline MrclamRun read_mrclam(const std::string& directory, int robot, const Mrcl
   for (const auto& [subject, position] : detail::read_landmarks(file("Landmark_Groundtruth.dat")))
     run.true_landmarks.emplace(subject, position);
   auto odometry = detail::read_timed_rows(file(prefix + "Odometry.dat"), 3, "t v w", options.max_gap);
-  for (auto& row : odometry) row.t += options.odometry_delay;
+  for (auto& row : odometry) {
+    row.t += options.odometry_delay;
+    const std::string where = file(prefix + "Odometry.dat") + ":" + std::to_string(row.line);
+    run.implausible.check(row.values[1], options.plausible_speed, where, "speed", "m/s");
+    run.implausible.check(row.values[2], options.plausible_rate, where, "turn rate", "rad/s");
+  }
   const auto truth = detail::read_timed_rows(file(prefix + "Groundtruth.dat"), 4, "t x y heading", options.max_gap);
   const auto measurements = detail::read_timed_rows(file(prefix + "Measurement.dat"), 4, "t barcode range bearing");
 

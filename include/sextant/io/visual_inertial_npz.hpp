@@ -16,6 +16,7 @@
 #include "sextant/core/error.hpp"
 #include "sextant/core/observation.hpp"
 #include "sextant/core/se3.hpp"
+#include "sextant/io/implausible_values.hpp"
 #include "sextant/io/npz_reader.hpp"
 #include "sextant/io/parse_number.hpp"
 #include "sextant/models/stereo_imu_se3.hpp"
@@ -39,6 +40,10 @@ struct VisualInertialNpzOptions {
   /// [s] the longest time between two frames (KITTI's: 0.1 s). A longer one is an error naming the
   /// frame: the IMU's velocities integrated over it would move the camera by whatever they say.
   double max_frame_gap = 60.0;
+  /// Beyond these a velocity is used but listed as implausible (VisualInertialDataset::implausible):
+  /// the speed in m/s per axis (KITTI's largest 17; a car on a motorway 40), the turn rate in rad/s
+  /// per axis (largest 0.66).
+  double plausible_speed = 100.0, plausible_rate = 6.283185307179586;
 };
 
 struct VisualInertialDataset {
@@ -52,6 +57,7 @@ struct VisualInertialDataset {
   std::size_t landmark_count = 0;                          ///< M: ids are 0 .. M - 1
   std::size_t observation_count = 0;
   std::size_t incomplete_observations = 0;  ///< some but not all four pixels -1: dropped, counted
+  ImplausibleValues implausible;  ///< velocities beyond VisualInertialNpzOptions' plausible limits
 };
 
 namespace detail {
@@ -203,6 +209,11 @@ inline VisualInertialDataset read_visual_inertial_npz(const std::string& path, c
     u << v.values[k - 1], v.values[T + k - 1], v.values[2 * T + k - 1], w.values[k - 1], w.values[T + k - 1],
         w.values[2 * T + k - 1];
     data.steps.push_back({u, data.time_stamps[k] - data.time_stamps[k - 1], std::move(frames[k])});
+    const std::string where = path + ": frame " + std::to_string(k - 1);
+    for (int i = 0; i < 3; ++i) {
+      data.implausible.check(u(i), options.plausible_speed, where, "linear velocity", "m/s");
+      data.implausible.check(u(3 + i), options.plausible_rate, where, "angular velocity", "rad/s");
+    }
   }
   return data;
 }
