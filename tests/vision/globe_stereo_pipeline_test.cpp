@@ -223,6 +223,20 @@ TEST(StereoSequence, BadDirectoriesGiveOneErrorNamingTheFile) {
              "%YAML:1.0\nK: !!opencv2matrix\n  ro:sw 3\n  cols: 3\n  : !!o\n  data::1.0\nK: !!opencv-mat data: [100,e_width: 3 1\x82 1, 1, 1]\n");
   expect_parse_error_naming(fuzzed, "calib.yaml", "calib.yaml");
 
+  // Found by the same fuzzer (a 30 s run, 2026-11-25): OpenCV 4.6's YAML parser loops forever on a
+  // mapping indented before any key followed by a line indented less. calib.yaml is now checked line
+  // by line before OpenCV reads it (vision/calibration_yaml_lint.hpp); the layout cv::FileStorage
+  // writes (3-space blocks, a list over two lines) still reads.
+  write_text(fuzzed / "calib.yaml", "%YAML:1.0\n  rows: 3\n ncv-matrix\n" + rest);
+  expect_parse_error_naming(fuzzed, "calib.yaml:2", "indented before any key");
+  write_text(fuzzed / "calib.yaml", "%YAML:1.0\n" + K + " ncv-matrix\n" + rest);
+  expect_parse_error_naming(fuzzed, "calib.yaml:7", "indented unlike the lines before it");
+  write_text(fuzzed / "calib.yaml", "%YAML:1.0?\xbd\n" + K + rest);
+  expect_parse_error_naming(fuzzed, "calib.yaml:1", "not printable text");
+  write_text(fuzzed / "calib.yaml", "%YAML:1.0\n---\nK: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+                                    "   data: [ 100., 0., 16., 0., 100.,\n       12., 0., 0., 1. ]\n" + rest);
+  EXPECT_NO_THROW(StereoSequence{fuzzed});
+
   for (const auto& d : {dir, counts, unreadable, sizes, names, huge, folders, image_folder, fuzzed}) std::filesystem::remove_all(d);
 }
 

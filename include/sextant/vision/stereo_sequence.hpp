@@ -22,6 +22,7 @@
 #include "sextant/core/gaussian.hpp"
 #include "sextant/io/parse_number.hpp"
 #include "sextant/models/euler_camera_12d.hpp"
+#include "sextant/vision/calibration_yaml_lint.hpp"
 #include "sextant/vision/stereo_triangulation.hpp"
 
 namespace sextant::vision {
@@ -117,6 +118,7 @@ inline StereoCalibration read_calibration(const std::filesystem::path& dir) {
   const std::string file = detail::calibration_file(dir).string();
   if (std::filesystem::is_directory(file)) throw parse_error(file + ": is a directory, not a file (the stereo calibration)");
   if (!std::filesystem::is_regular_file(file)) throw parse_error(file + ": no such file (the stereo calibration)");
+  detail::lint_calibration_yaml(file);  // before OpenCV's parser, which can loop forever on a malformed file
   cv::FileStorage fs;
   bool opened = false;
   try {  // OpenCV's parser throws cv::Exception, and on some malformed files std::length_error
