@@ -47,10 +47,10 @@ inline bool left_out(BackendKind kind, const RunnerConfig& c, const std::string&
 }
 
 /// The row of a back-end that failed as a whole: its message instead of scores.
-inline TableRow failed_row(const std::string& dataset, const BackendChoice& choice, const error& e) {
+inline TableRow failed_row(const std::string& dataset, const BackendChoice& choice, std::string why) {
   TableRow row{dataset, choice.key, choice.label, {}, 1, std::nullopt, std::nullopt};
   row.summary.mark_unscored();
-  row.failure = e.what();
+  row.failure = std::move(why);
   return row;
 }
 
@@ -115,10 +115,8 @@ std::vector<TableRow> run_on_rawlog(const std::string& name, const Dataset& data
     if (left_out(kind, c, name)) continue;
     ProgressBar progress(name + ": " + choice.key, data.steps.size());
     BackendRun<Dataset> result;
-    try {
-      result = run_backend(choice, data, c, [&](std::size_t) { progress.advance(); });
-    } catch (const error& e) {  // the back-end as a whole (its construction, optimize(), map()): its row says so
-      rows.push_back(failed_row(name, choice, e));
+    if (auto why = failure_of([&] { result = run_backend(choice, data, c, [&](std::size_t) { progress.advance(); }); })) {
+      rows.push_back(failed_row(name, choice, std::move(*why)));  // its row says so; the others still run
       continue;
     }
     rows.push_back({name, choice.key, choice.label,
@@ -145,7 +143,7 @@ std::vector<TableRow> run_on_ship(const std::vector<BackendKind>& kinds, const R
     std::optional<BackendRun<Dataset>> first;
     std::mutex first_mutex;
     std::vector<eval::RunSummary<typename BackendRun<Dataset>::State>> runs;
-    try {
+    const auto why = failure_of([&] {
       runs = eval::monte_carlo(c.ship_runs, c.ship.seed, [&](std::uint64_t seed) {
         sim::Ship2DOptions o = c.ship;
         o.seed = seed;
@@ -157,8 +155,9 @@ std::vector<TableRow> run_on_ship(const std::vector<BackendKind>& kinds, const R
         }
         return result.run;
       });
-    } catch (const error& e) {  // one seed's back-end as a whole: the row says so, the others still run
-      rows.push_back(failed_row("ship", choice, e));
+    });
+    if (why) {  // one seed's back-end as a whole: the row says so, the others still run
+      rows.push_back(failed_row("ship", choice, *why));
       continue;
     }
     rows.push_back({"ship", choice.key, choice.label,

@@ -207,9 +207,7 @@ void print_globe_row(const GlobeRun& r, std::size_t steps) {
               1e3 * s.map_mae_aligned, share(s.position_nees_inside).c_str(), share(s.rotation_nees_inside).c_str(),
               share(s.map_nees_inside).c_str(), number(s.position_anees).c_str(), r.total_seconds,
               1e3 * r.total_seconds / static_cast<double>(steps));
-  if (r.failures.total() > 0)
-    std::printf("%-27s %zu failed step%s skipped (the back-end kept its state); first: %s\n", "", r.failures.total(),
-                r.failures.total() == 1 ? "" : "s", r.failures.first.c_str());
+  print_skipped_steps(27, r.failures.total(), "step", r.failures.first);
 }
 
 TableRow table_row(const GlobeRun& r, std::size_t steps) {

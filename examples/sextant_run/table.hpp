@@ -50,12 +50,12 @@ inline void print_warnings(const io::ImplausibleValues& implausible) {
   for (const auto& line : implausible.warnings()) std::printf("%s\n", line.c_str());
 }
 
-/// A row's second line when some of its steps failed and were skipped (eval::StepErrors::skip).
-inline void print_failed_steps(const TableRow& row) {
-  const auto& s = row.summary;
-  if (s.failed_steps == 0) return;
-  std::printf("%-29s %zu failed step%s skipped (the back-end kept its state), over %d run%s; first: %s\n", "",
-              s.failed_steps, s.failed_steps == 1 ? "" : "s", row.runs, row.runs == 1 ? "" : "s", s.first_failure.c_str());
+/// The line below a row whose steps (or frames) failed and were skipped (eval::StepErrors::skip),
+/// indented by `indent` characters; nothing for none. Every family's table prints it.
+inline void print_skipped_steps(int indent, std::size_t count, const char* unit, const std::string& first) {
+  if (count == 0) return;
+  std::printf("%-*s %zu failed %s%s skipped (the back-end kept its state); first: %s\n", indent, "", count, unit,
+              count == 1 ? "" : "s", first.c_str());
 }
 
 inline void print_row(const TableRow& row) {
@@ -71,7 +71,7 @@ inline void print_row(const TableRow& row) {
   if (const auto& a = row.association)
     std::printf("%-29s association: precision %.4f, recall %.4f; %zu wrong pairings, %zu duplicate landmarks, %zu "
                 "discarded\n", "", a->precision, a->recall, a->wrong, a->duplicates, a->discarded);
-  print_failed_steps(row);
+  print_skipped_steps(29, row.summary.failed_steps, "step", row.summary.first_failure);  // over all its runs
 }
 
 inline std::string json_number(double x) {

@@ -243,9 +243,7 @@ void print_table(const ViData& d, const std::vector<ViRun>& runs) {
                 r.in_state, r.updates.initialized, r.updates.corrected, r.updates.rejected, r.updates.unusable, number_or_dash(r.rmse, "%.2f").c_str(),
                 number_or_dash(dead_reckoning_rmse / r.rmse, "%.2fx").c_str(), number_or_dash(r.anees, "%.2f").c_str(),
                 1e3 * r.seconds / static_cast<double>(d.frames.size()));
-    if (r.failures.total() > 0)
-      std::printf("%-38s %zu failed frame%s skipped (the back-end kept its state); first: %s\n", "", r.failures.total(),
-                  r.failures.total() == 1 ? "" : "s", r.failures.first.c_str());
+    print_skipped_steps(38, r.failures.total(), "frame", r.failures.first);
   }
   std::printf("RMSE: position against %s; vs DR: dead reckoning's RMSE over this one (higher is better); in state: "
               "landmarks in the state at the end (pool of at most that many); mapped: landmarks added; unusable: "

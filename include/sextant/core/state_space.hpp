@@ -38,12 +38,13 @@ struct EuclideanSpace {
 /// A space on a group (Se3Space, Se2WorldSpace) defines them; for an additive chart (plus is +, minus
 /// is -, angles wrapped: EuclideanSpace, Se2Space, Pose3EulerSpace, the globe camera's) they are
 /// I, -I and I exactly, which these give for a space that does not define them.
-/// The square matrix over a space's tangent (its dimension from minus, which every space has).
+
+/// The dimension of a space's tangent, from minus (which every space has), and the square matrix over it.
 template <class Space, class Point>
-using TangentJacobian = Eigen::Matrix<double, decltype(Space::minus(std::declval<const Point&>(),
-                                                                    std::declval<const Point&>()))::RowsAtCompileTime,
-                                      decltype(Space::minus(std::declval<const Point&>(),
-                                                            std::declval<const Point&>()))::RowsAtCompileTime>;
+inline constexpr int tangent_dim_v =
+    decltype(Space::minus(std::declval<const Point&>(), std::declval<const Point&>()))::RowsAtCompileTime;
+template <class Space, class Point>
+using TangentJacobian = Eigen::Matrix<double, tangent_dim_v<Space, Point>, tangent_dim_v<Space, Point>>;
 
 template <class Space, class Point>
 TangentJacobian<Space, Point> minus_jacobian_first(const Point& a, const Point& b) {

@@ -231,14 +231,15 @@ void GraphSlam<Motion, Sensor>::add_marginal_factors(Linearization& sys) const {
     for (std::size_t i = 0; i < count; ++i)
       d.template segment<X>(X * i) = Space::minus(poses_[factor.poses[i]], factor.linearization[i]);
     Eigen::VectorXd b = factor.eta - factor.Lambda * d;
-    Eigen::MatrixXd Lambda = factor.Lambda;
+    Eigen::MatrixXd in_current_tangents;  // D^T Lambda D where the chart needs it
     if constexpr (has_minus_jacobians_v<Space, State>) {
       Eigen::MatrixXd D = Eigen::MatrixXd::Zero(d.size(), d.size());
       for (std::size_t i = 0; i < count; ++i)
         D.template block<X, X>(X * i, X * i) = minus_jacobian_first<Space>(poses_[factor.poses[i]], factor.linearization[i]);
       b = (D.transpose() * b).eval();
-      Lambda = (D.transpose() * factor.Lambda * D).eval();
+      in_current_tangents = D.transpose() * factor.Lambda * D;
     }
+    const Eigen::MatrixXd& Lambda = has_minus_jacobians_v<Space, State> ? in_current_tangents : factor.Lambda;
     for (std::size_t i = 0; i < count; ++i) {
       sys.pose_rhs.template segment<X>(X * factor.poses[i]) += b.template segment<X>(X * i);
       for (std::size_t k = 0; k < count; ++k) {
