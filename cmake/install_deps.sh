@@ -3,9 +3,11 @@
 set -euo pipefail
 # libmrpt-dev: rawlogs, 3D scenes, CConfigFile; mrpt-common: the kf-slam demo rawlogs; libzip-dev: .npz files;
 # libopencv-dev: the visual front-end (sextant::vision); python3-matplotlib: --plots; clang: run.sh's
-# compiler (docs/build_times.md), g++ the benchmarks' and the thread-sanitizer build's
+# compiler (docs/build_times.md), g++ the benchmarks' and the thread-sanitizer build's; libopenmpi-dev,
+# openmpi-bin: mpirun over a Monte Carlo study's seeds (docs/monte_carlo_clusters.md)
 packages=(cmake make g++ clang libeigen3-dev libboost-dev libgtest-dev libbenchmark-dev libcli11-dev libsuitesparse-dev libceres-dev
-          libmrpt-dev mrpt-common libzip-dev libopencv-dev python3-matplotlib "$@")  # "$@": extra packages to install
+          libmrpt-dev mrpt-common libzip-dev libopencv-dev python3-matplotlib
+          libopenmpi-dev openmpi-bin "$@")  # "$@": extra packages to install
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -10,6 +10,7 @@
 #include <map>
 #include <unistd.h>
 
+#include "mpi_world.hpp"
 #include "runner_config.hpp"
 #include "sextant/core/error.hpp"
 
@@ -27,7 +28,7 @@ bool has_extension(const std::string& dataset, const char* extension) {
 const std::vector<DatasetFamily>& dataset_families() {
   static const std::vector<DatasetFamily> families = {
       {"ship", "ship", "sextant-run", [](const std::string& d) { return is(d, "ship"); },
-       "the thesis's 2D beacon ship, a Monte Carlo over [ship] runs seeds"},
+       "the thesis's 2D beacon ship, a Monte Carlo over [ship] runs seeds", true},
       {"mrpt-demos", "mrpt-demos", "sextant-run", [](const std::string& d) { return is(d, "mrpt-demos"); },
        "MRPT's kf-slam demo rawlogs (Debian's mrpt-common)"},
       {"globe", "globe", "sextant-globe", [](const std::string& d) { return is(d, "globe"); },
@@ -122,8 +123,19 @@ int hand_over_to(const char* program, char** argv) {
   return 1;
 }
 
+/// Whether this process runs `dataset`: a shard (--shard or an MPI rank) runs its share of the seeded
+/// data sets; the others run in one process only (MPI's rank 0), and --shard refuses them when named.
+bool runs_here(const CliOptions& options, const std::string& dataset, bool named) {
+  if (family_of(dataset).seeded || options.study.mode == StudyPart::Mode::whole) return true;
+  if (options.study.mode == StudyPart::Mode::mpi) return options.study.prints();
+  if (named)
+    throw invalid_input_error("--shard: --dataset " + dataset + " is one run, not a Monte Carlo over seeds (only " +
+                              "seeded data sets such as ship are sharded)");
+  return false;
+}
+
 /// The data sets of this program (sextant-run hands the others over before): each by its family's run.
-int run_own_datasets(CliOptions& options, const RunnerProgram& program) {
+int run_own_datasets(CliOptions& options, const RunnerProgram& program, bool named) {
   for (const auto& dataset : options.datasets)
     if (std::strcmp(family_of(dataset).program, program.name) != 0)
       throw invalid_input_error("--dataset " + dataset + ": " + program.name + " runs " + program.runs +
@@ -132,11 +144,34 @@ int run_own_datasets(CliOptions& options, const RunnerProgram& program) {
   const auto kinds = parse_backends(options.backends);
   std::vector<TableRow> rows;
   for (const auto& dataset : options.datasets) {
+    if (!runs_here(options, dataset, named)) continue;
     auto part = registered_run(family_of(dataset).key)(options, dataset, kinds, config);
     rows.insert(rows.end(), part.begin(), part.end());
   }
-  finish_run(options, rows);
+  if (options.study.prints()) finish_run(options, rows);
   return 0;
+}
+
+/// Runs this program's data sets as this process's part of their studies (monte_carlo_study.hpp):
+/// joins MPI when mpirun started it and leaves it however the run ends; a rank that fails says so and
+/// ends all of them (the others would wait for its records).
+int run_as_study_part(int argc, char** argv, CliOptions& options, const RunnerProgram& program, bool named) {
+  try {
+    options.study = study_part(program.name, options.shard, options.output.out, argc, argv, options.config);
+    if (!options.study.prints()) std::freopen("/dev/null", "w", stdout);  // rank 0 prints the table
+    const int status = run_own_datasets(options, program, named);
+    mpi::leave(status != 0);
+    return status;
+  } catch (const std::exception& e) {
+    if (options.study.mode != StudyPart::Mode::mpi) {
+      mpi::leave(false);
+      throw;
+    }
+    std::fprintf(stderr, "%s (rank %d of %d): %s\n", program.name, options.study.shard.index,
+                 options.study.shard.count, e.what());
+    mpi::leave(true);
+    return 1;
+  }
 }
 
 }  // namespace
@@ -153,10 +188,17 @@ DatasetRun registered_run(const std::string& key) {
 int program_main(int argc, char** argv, const char* name) {
   const RunnerProgram& program = runner_program(name);
   return runner_main(argc, argv, program.name, program.description, [&](CliOptions& options) {
-    if (options.datasets.empty()) options.datasets = program.defaults;
+    if (!options.merge.empty()) {
+      if (!options.datasets.empty() || !options.shard.empty())
+        throw invalid_input_error("--merge prints a study from its records: no --dataset or --shard with it");
+      finish_run(options, merged_rows(program.name, options.merge));
+      return 0;
+    }
+    const bool named = !options.datasets.empty();
+    if (!named) options.datasets = program.defaults;
     if (std::strcmp(name, "sextant-run") == 0)
       if (const char* other = handed_over_to(options.datasets, name)) return hand_over_to(other, argv);
-    return run_own_datasets(options, program);
+    return run_as_study_part(argc, argv, options, program, named);
   });
 }
 

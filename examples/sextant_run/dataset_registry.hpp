@@ -18,6 +18,7 @@ struct DatasetFamily {
   const char* program;                           ///< the program that runs it
   bool (*recognizes)(const std::string& dataset);
   const char* help;                              ///< one line for --help
+  bool seeded = false;  ///< a Monte Carlo over seeds, which --shard and mpirun split (monte_carlo_study.hpp)
 };
 
 /// Every family, in the order a --dataset argument is tried against them (the catch-all last).

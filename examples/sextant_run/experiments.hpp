@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "backend_factory.hpp"
+#include "monte_carlo_study.hpp"
 #include "progress_bar.hpp"
 #include "runner_config.hpp"
 #include "table.hpp"
@@ -129,44 +130,44 @@ std::vector<TableRow> run_on_rawlog(const std::string& name, const Dataset& data
   return rows;
 }
 
-/// Every chosen back-end on `runs` simulated ships (seeds in parallel); the first seed's run of
-/// each back-end goes to `first_runs`.
+/// Every chosen back-end on the simulated ships of `seeds` (in parallel on `threads` threads, 0: all
+/// cores): a record per back-end and seed (monte_carlo_study.hpp), a seed whose back-end failed as a
+/// whole recorded with its message; the run of each back-end on the study's first seed goes to
+/// `first_runs` when `seeds` holds it.
 template <class Dataset>
-std::vector<TableRow> run_on_ship(const std::vector<BackendKind>& kinds, const RunnerConfig& c,
-                                  std::vector<std::pair<BackendKind, BackendRun<Dataset>>>& first_runs) {
+std::vector<eval::StudyRecord> ship_records(const std::vector<BackendKind>& kinds, const RunnerConfig& c,
+                                          eval::SeedRange seeds, unsigned threads,
+                                          std::vector<std::pair<BackendKind, BackendRun<Dataset>>>& first_runs) {
   constexpr Scoring scoring = scoring_of<Dataset>();
-  std::vector<TableRow> rows;
+  std::vector<eval::StudyRecord> records;
   for (const auto& choice : backend_choices<std::decay_t<decltype(Dataset::motion)>>(kinds, c)) {
-    const BackendKind kind = choice.kind;
-    if (left_out(kind, c, "ship")) continue;
-    ProgressBar progress("ship: " + choice.key, static_cast<std::size_t>(c.ship_runs));
+    if (left_out(choice.kind, c, "ship")) continue;
+    ProgressBar progress("ship: " + choice.key, static_cast<std::size_t>(seeds.count));
     std::optional<BackendRun<Dataset>> first;
     std::mutex first_mutex;
-    std::vector<eval::RunSummary<typename BackendRun<Dataset>::State>> runs;
-    const auto why = failure_of([&] {
-      runs = eval::monte_carlo(c.ship_runs, c.ship.seed, [&](std::uint64_t seed) {
-        sim::Ship2DOptions o = c.ship;
-        o.seed = seed;
-        auto result = run_backend(choice, sim::simulate_ship_2d(o), c, [](std::size_t) {});
-        progress.advance();
-        if (seed == c.ship.seed) {
-          std::lock_guard lock(first_mutex);
-          first = result;
-        }
-        return result.run;
-      });
-    });
-    if (why) {  // one seed's back-end as a whole: the row says so, the others still run
-      rows.push_back(failed_row("ship", choice, *why));
-      continue;
-    }
-    rows.push_back({"ship", choice.key, choice.label,
-                    eval::summarize(runs, scoring.pose_dof, scoring.landmark_dof), c.ship_runs, std::nullopt, std::nullopt});
-    if (const auto& a = first->association)  // the first seed's
-      rows.back().association = association_row(*a);
-    first_runs.emplace_back(kind, std::move(*first));
+    auto runs = eval::monte_carlo(seeds.count, seeds.first, [&](std::uint64_t seed) {
+      eval::StudyRecord record{"ship", choice.key, choice.label, scoring.pose_dof, seed, {}, {}, {}};
+      sim::Ship2DOptions o = c.ship;
+      o.seed = seed;
+      BackendRun<Dataset> result;
+      const auto why = failure_of([&] { result = run_backend(choice, sim::simulate_ship_2d(o), c, [](std::size_t) {}); });
+      progress.advance();
+      if (why) {  // this seed's back-end as a whole: the row says so, the others still run
+        record.failure = *why;
+        return record;
+      }
+      record.scores = eval::scores_of(result.run, scoring.pose_dof, scoring.landmark_dof);
+      if (const auto& a = result.association) record.extras = association_extras(association_row(*a));
+      if (seed == c.ship.seed) {
+        std::lock_guard lock(first_mutex);
+        first = std::move(result);
+      }
+      return record;
+    }, threads);
+    records.insert(records.end(), std::make_move_iterator(runs.begin()), std::make_move_iterator(runs.end()));
+    if (first) first_runs.emplace_back(choice.kind, std::move(*first));
   }
-  return rows;
+  return records;
 }
 
 }  // namespace sextant::runner

@@ -27,6 +27,11 @@ void add_runner_options(CLI::App& app, CliOptions& options, const char* program)
                  "known|nn|jcbb: use the data set's landmark ids, or withhold them and associate by nearest neighbour "
                  "or JCBB (EKF and SEIF; FastSLAM associates per particle; overrides [association] method)");
   app.add_option("--runs", options.runs, "Monte Carlo runs on the ship (overrides [ship] runs)")->check(CLI::Range(1, 100000));
+  app.add_option("--shard", options.shard,
+                 "i/K: run only shard i (from 0) of K of the Monte Carlo seeds and write their records to --out "
+                 "(records-i-of-K.tsv) for --merge; under mpirun each rank takes its shard by itself");
+  app.add_option("--merge", options.merge,
+                 "record files or directories of one study's shards: print the table of the whole study (repeatable)");
   app.add_flag("--plots", options.output.plots, "also write PNG plots of trajectory, map, error and NEES (needs --out or "
                                                 "writes to ./sextant-run-output)");
   app.add_option("--save-images", options.save_images,

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "dataset_runs.hpp"
+#include "monte_carlo_study.hpp"
 
 namespace sextant::runner {
 
@@ -20,6 +21,9 @@ struct CliOptions {
   bool print_config = false;
   std::string save_images;  ///< globe-stereo: write the rendered sequence here
   RunOptions output;
+  std::string shard;               ///< --shard i/K: run only that share of the Monte Carlo seeds
+  std::vector<std::string> merge;  ///< --merge: record files or directories of one study to print the table of
+  StudyPart study;                 ///< this process's part in Monte Carlo studies (program_main sets it)
 };
 
 std::vector<BackendKind> parse_backends(const std::vector<std::string>& names);

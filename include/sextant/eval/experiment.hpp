@@ -12,6 +12,7 @@
 
 #include "sextant/eval/alignment.hpp"
 #include "sextant/eval/metrics.hpp"
+#include "sextant/eval/run_scores.hpp"
 #include "sextant/eval/runner.hpp"
 
 namespace sextant::eval {
@@ -174,68 +175,35 @@ RunSummary<typename Backend::State> evaluate_smoothed_run(Backend& backend, cons
   return out;
 }
 
-/// Averages over runs: MAE of pose and map, share of NEES inside the one-sided bound, time, and
-/// with two or more runs the pose ANEES (over runs and steps) with the two-sided interval of that
-/// average (time_averaged_anees_interval).
-struct Summary {
-  double pose_mae = 0.0, map_mae = 0.0, map_mae_over_time = 0.0;
-  double pose_rmse = 0.0;  ///< root mean square of the position error over the steps, averaged over runs
-  double pose_rmse_aligned = 0.0;  ///< the same after rigid alignment of the trajectory to the truth (evo's APE)
-  double pose_mae_aligned = 0.0, map_mae_aligned = 0.0;  ///< after rigid alignment to the truth
-  double pose_nees_inside = 0.0, map_nees_inside = 0.0;  ///< fractions in [0, 1]
-  double total_seconds = 0.0, seconds_per_step = 0.0;
-  double pose_anees = 0.0;
-  std::optional<Interval> anees_interval;
-  double pose_mae_std = 0.0;  ///< standard deviation of the per-run pose MAE
-  double map_mae_std = 0.0;
-  std::size_t failed_steps = 0;  ///< steps skipped over all runs (StepErrors::skip)
-  std::string first_failure;     ///< the first run's first skipped step that has one
+/// The scores of one run, reduced to the numbers the average over runs needs (RunScores), with the
+/// bound of the one-sided NEES test at `confidence`.
+template <class State>
+RunScores scores_of(const RunSummary<State>& r, int pose_dof, int landmark_dof, double confidence = 0.95) {
+  RunScores s;
+  s.steps = r.seconds.size();
+  s.pose_mae = mean(r.pose_error);
+  s.pose_rmse = rms(r.pose_error);
+  s.pose_rmse_aligned = rms(r.pose_error_aligned);
+  s.pose_mae_aligned = mean(r.pose_error_aligned);
+  s.map_mae = mean(r.map_error);
+  s.map_mae_over_time = r.map_error_over_time;
+  s.map_mae_aligned = mean(r.map_error_aligned);
+  s.pose_nees_inside = fraction_at_most(r.pose_nees, nees_upper_bound(pose_dof, confidence));
+  s.map_nees_inside = fraction_at_most(r.map_nees, nees_upper_bound(landmark_dof, confidence));
+  s.pose_anees = mean(r.pose_nees);
+  s.total_seconds = r.total_seconds;
+  s.failed_steps = r.failures.total();
+  s.first_failure = r.failures.first;
+  return s;
+}
 
-  /// Marks every score NaN (a run without ground truth has only its time).
-  void mark_unscored() {
-    constexpr double none = std::numeric_limits<double>::quiet_NaN();
-    pose_mae = map_mae = map_mae_over_time = pose_rmse = pose_rmse_aligned = pose_mae_aligned = map_mae_aligned = none;
-    pose_nees_inside = map_nees_inside = pose_anees = pose_mae_std = map_mae_std = none;
-    anees_interval.reset();
-  }
-};
-
+/// The average of runs (summarize over their RunScores, in the order given).
 template <class State>
 Summary summarize(const std::vector<RunSummary<State>>& runs, int pose_dof, int landmark_dof, double confidence = 0.95) {
-  Summary s;
-  if (runs.empty()) return s;
-  const double n = static_cast<double>(runs.size());
-  std::vector<double> pose_maes, map_maes, nees_averages;
-  for (const auto& r : runs) {
-    pose_maes.push_back(mean(r.pose_error));
-    s.pose_rmse += rms(r.pose_error) / n;
-    s.pose_rmse_aligned += rms(r.pose_error_aligned) / n;
-    map_maes.push_back(mean(r.map_error));
-    s.pose_nees_inside += fraction_at_most(r.pose_nees, nees_upper_bound(pose_dof, confidence)) / n;
-    s.map_nees_inside += fraction_at_most(r.map_nees, nees_upper_bound(landmark_dof, confidence)) / n;
-    s.total_seconds += r.total_seconds / n;
-    s.map_mae_over_time += r.map_error_over_time / n;
-    s.pose_mae_aligned += mean(r.pose_error_aligned) / n;
-    s.map_mae_aligned += mean(r.map_error_aligned) / n;
-    nees_averages.push_back(mean(r.pose_nees));
-    s.failed_steps += r.failures.total();
-    if (s.first_failure.empty()) s.first_failure = r.failures.first;
-  }
-  auto standard_deviation = [](const std::vector<double>& v) {
-    const double m = mean(v);
-    double sum = 0.0;
-    for (double x : v) sum += (x - m) * (x - m);
-    return v.size() > 1 ? std::sqrt(sum / static_cast<double>(v.size() - 1)) : 0.0;
-  };
-  s.pose_mae = mean(pose_maes);
-  s.map_mae = mean(map_maes);
-  s.pose_mae_std = standard_deviation(pose_maes);
-  s.map_mae_std = standard_deviation(map_maes);
-  s.seconds_per_step = s.total_seconds / static_cast<double>(std::max<std::size_t>(1, runs.front().seconds.size()));
-  s.pose_anees = mean(nees_averages);
-  if (runs.size() > 1 && std::isfinite(s.pose_anees))
-    s.anees_interval = time_averaged_anees_interval(pose_dof, nees_averages, confidence);
-  return s;
+  std::vector<RunScores> scores;
+  scores.reserve(runs.size());
+  for (const auto& r : runs) scores.push_back(scores_of(r, pose_dof, landmark_dof, confidence));
+  return summarize(scores, pose_dof, confidence);
 }
 
 /// A run without ground truth (e.g. Victoria Park): the trajectory and the time of every step and
