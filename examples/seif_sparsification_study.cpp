@@ -7,17 +7,13 @@
 #include <string>
 #include <vector>
 
+#include "study_program.hpp"
+
 namespace {
 
 using namespace sextant;
 using ShipSeif = SeifSlam<BeaconShip2D, BeaconOffset2D>;
 using ShipEkf = EkfSlam<BeaconShip2D, BeaconOffset2D>;
-
-struct Scored {
-  eval::RunSummary<Eigen::Vector2d> run;
-  double map_mae_exact = 0.0;  ///< map MAE after one exact mean recovery at the end
-  std::size_t active_at_end = 0;
-};
 
 struct ThesisRow {
   const char* active;
@@ -28,69 +24,78 @@ constexpr ThesisRow kThesis[] = {{"4", 19.8210, 13.6132}, {"5", 19.5655, 13.029}
                                  {"7", 19.7833, 13.1154}, {"8", 19.5590, 12.8565}, {"50", 19.5641, 12.4693},
                                  {"all", 19.433, 8.4729}};
 
+/// One seed of a cell: the back-end's scores, and the map MAE after one exact mean recovery.
+template <class MakeBackend>
+eval::StudyRecord seed_record(const std::string& cell, const std::string& label, const sim::Ship2DOptions& options,
+                              std::uint64_t seed, MakeBackend make_backend) {
+  sim::Ship2DOptions o = options;
+  o.seed = seed;
+  const auto data = sim::simulate_ship_2d(o);
+  auto backend = make_backend(data);
+  eval::StudyRecord record{"ship", cell, label, 2, seed, eval::scores_of(eval::evaluate_run(backend, data), 2, 2), {}, {}};
+  if constexpr (requires { backend.recover_mean_exactly(); }) backend.recover_mean_exactly();
+  record.extras = {{"map_mae_exact", eval::mean(eval::evaluate_map(backend.map(), data.true_landmarks).errors)}};
+  return record;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"sextant: SEIF-SLAM against the number of active landmarks (thesis Table 5)"};
-  int runs = 20;
+  runner::StudyCommandLine study;
   sim::Ship2DOptions options;
   std::string recovery = "block";
-  app.add_option("--runs", runs, "Monte Carlo runs")->check(CLI::Range(2, 100000))->capture_default_str();
-  app.add_option("--seed", options.seed, "first seed")->capture_default_str();
+  study.add_to(app);
   app.add_option("--recovery", recovery, "mean recovery: block (joint robot + active) or cd (thesis coordinate descent)")
       ->check(CLI::IsMember({"block", "cd"}))
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   const MeanRecovery mean_recovery = recovery == "cd" ? MeanRecovery::coordinate_descent : MeanRecovery::active_block;
+  const std::size_t actives[] = {4, 5, 6, 7, 8, 50, 0};
+  const auto seif_cell = [](std::size_t active) { return active == 0 ? std::string("seif-all") : "seif-" + std::to_string(active); };
+  const auto seif_label = [](std::size_t active) {
+    return active == 0 ? std::string("SEIF, all active") : "SEIF, " + std::to_string(active) + " active";
+  };
 
   try {
-    auto score = [&](auto make_backend) {
-      return eval::monte_carlo(runs, options.seed, [&](std::uint64_t seed) {
-        sim::Ship2DOptions o = options;
-        o.seed = seed;
-        const auto data = sim::simulate_ship_2d(o);
-        auto backend = make_backend(data);
-        Scored out{eval::evaluate_run(backend, data), 0.0, 0};
-        if constexpr (requires { backend.recover_mean_exactly(); }) {
-          out.active_at_end = backend.active_landmarks().size();
-          backend.recover_mean_exactly();
-        }
-        out.map_mae_exact = eval::mean(eval::evaluate_map(backend.map(), data.true_landmarks).errors);
-        return out;
+    runner::StudyRun run("sextant-seif-study", study, argc, argv);
+    options.seed = study.seed;
+    run.add_cell([&](std::uint64_t seed) {
+      return seed_record("ekf", "EKF-SLAM", options, seed, [](const auto& d) { return ShipEkf{d.motion, d.sensor, d.prior}; });
+    });
+    for (const std::size_t max_active : actives)
+      run.add_cell([&](std::uint64_t seed) {
+        return seed_record(seif_cell(max_active), seif_label(max_active), options, seed, [&](const auto& d) {
+          return ShipSeif{d.motion, d.sensor, d.prior, {.max_active = max_active, .mean_recovery = mean_recovery}};
+        });
       });
-    };
-    auto print_row = [&](const std::string& name, const std::vector<Scored>& scored, const ThesisRow* thesis) {
-      std::vector<eval::RunSummary<Eigen::Vector2d>> plain;
+    const auto records = run.finish();
+    auto print_row = [&](const std::string& cell, const ThesisRow* thesis) {
+      const auto runs = runner::cell_records(records, cell);
+      if (runs.empty()) return;
       double exact = 0.0;
-      for (const auto& s : scored) {
-        plain.push_back(s.run);
-        exact += s.map_mae_exact / static_cast<double>(scored.size());
-      }
-      const auto s = eval::summarize(plain, 2, 2);
-      std::printf("| %s | %.2f ± %.2f | %.2f ± %.2f | %.2f | %.3f [%.3f, %.3f] | %.1f%% | %.2f | ", name.c_str(),
-                  s.pose_mae, s.pose_mae_std, s.map_mae, s.map_mae_std, exact, s.pose_anees, s.anees_interval->lower,
-                  s.anees_interval->upper, 100.0 * s.pose_nees_inside, 1e6 * s.seconds_per_step);
+      for (const auto& r : runs) exact += r.extra("map_mae_exact") / static_cast<double>(runs.size());
+      const auto s = eval::summarize(runner::scores_of(runs), 2);
+      std::printf("| %s | %.2f ± %.2f | %.2f ± %.2f | %.2f | %s | %.1f%% | %.2f | ", runs.front().label.c_str(), s.pose_mae,
+                  s.pose_mae_std, s.map_mae, s.map_mae_std, exact, runner::anees_with_interval(s, "%.3f", 3).c_str(),
+                  100.0 * s.pose_nees_inside, 1e6 * s.seconds_per_step);
       if (thesis)
         std::printf("%.2f | %.2f |\n", thesis->pose, thesis->map);
       else
         std::printf("19.13 | 8.59 |\n");
     };
-    std::printf("Ship 2D, %d Monte Carlo runs (seeds %llu..%llu), mean recovery: %s\n\n", runs,
-                static_cast<unsigned long long>(options.seed), static_cast<unsigned long long>(options.seed + runs - 1),
+    std::printf("Ship 2D, %d Monte Carlo runs (seeds %llu..%llu), mean recovery: %s\n\n", run.runs(),
+                static_cast<unsigned long long>(run.first_seed()),
+                static_cast<unsigned long long>(run.first_seed() + run.runs() - 1),
                 recovery == "cd" ? "thesis coordinate descent" : "joint robot + active block");
+    if (run.part().mode == runner::StudyPart::Mode::shard)
+      std::printf("(this shard %s: seeds %s only)\n\n", eval::to_string(run.part().shard).c_str(),
+                  eval::to_string(run.part().seeds(study.runs, study.seed)).c_str());
     std::printf("| back-end | pose MAE [km] | map MAE [km] | map MAE after exact recovery [km] | pose ANEES [95%% interval] "
                 "| pose NEES <= 5.991 | per step [us] | thesis pose MAE | thesis map MAE |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|\n");
-    print_row("EKF-SLAM", score([](const auto& d) { return ShipEkf{d.motion, d.sensor, d.prior}; }), nullptr);
-    const std::size_t actives[] = {4, 5, 6, 7, 8, 50, 0};
-    for (std::size_t i = 0; i < std::size(actives); ++i) {
-      const std::size_t max_active = actives[i];
-      const auto scored = score([&](const auto& d) {
-        return ShipSeif{d.motion, d.sensor, d.prior, {.max_active = max_active, .mean_recovery = mean_recovery}};
-      });
-      print_row(max_active == 0 ? "SEIF, all active" : "SEIF, " + std::to_string(max_active) + " active", scored,
-                &kThesis[i]);
-    }
+    print_row("ekf", nullptr);
+    for (std::size_t i = 0; i < std::size(actives); ++i) print_row(seif_cell(actives[i]), &kThesis[i]);
   } catch (const sextant::error& e) {
     std::fprintf(stderr, "sextant-seif-study: %s\n", e.what());
     return 1;

@@ -158,7 +158,6 @@ int run_own_datasets(CliOptions& options, const RunnerProgram& program, bool nam
 int run_as_study_part(int argc, char** argv, CliOptions& options, const RunnerProgram& program, bool named) {
   try {
     options.study = study_part(program.name, options.shard, options.output.out, argc, argv, options.config);
-    if (!options.study.prints()) std::freopen("/dev/null", "w", stdout);  // rank 0 prints the table
     const int status = run_own_datasets(options, program, named);
     mpi::leave(status != 0);
     return status;

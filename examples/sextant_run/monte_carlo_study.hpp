@@ -1,54 +1,24 @@
 #pragma once
-// How this process takes part in a Monte Carlo study of the runner (docs/monte_carlo_clusters.md):
-// it runs every seed; or one shard of them (--shard i/K), writing their records for --merge; or, as
-// one of mpirun's ranks, the shard of its rank, gathered on rank 0, which prints the whole table. In
-// every case the table is made from the runs' records (eval/study_records.hpp), so all three print the
-// same scores.
-#include <cstdint>
+// The runner's table from a Monte Carlo study's records (study_part.hpp): its rows, and --merge.
 #include <string>
+#include <utility>
 #include <vector>
 
-#include <sextant/eval/study_records.hpp>
-
+#include "study_part.hpp"
 #include "table_row.hpp"
 
 namespace sextant::runner {
-
-struct StudyPart {
-  enum class Mode { whole, shard, mpi };
-  Mode mode = Mode::whole;
-  eval::Shard shard;    ///< this process's share of the seeds
-  unsigned threads = 0;  ///< threads for its runs (0: every core; MPI: the cores over the ranks on this machine)
-  std::string program;
-  std::string study;  ///< what identifies the study: the command line but --shard/--out/--plots, and the config file's hash
-
-  /// The seeds this process runs of a study of `runs` runs from `first_seed`.
-  eval::SeedRange seeds(int runs, std::uint64_t first_seed) const { return eval::seeds_of(shard, runs, first_seed); }
-
-  /// Whether this process prints tables (every one but MPI's ranks other than 0).
-  bool prints() const { return mode != Mode::mpi || shard.index == 0; }
-};
-
-/// The part this process plays, from --shard, the MPI launch (mpi_world.hpp) and the command line.
-StudyPart study_part(const std::string& program, const std::string& shard, const std::string& out, int argc,
-                     char** argv, const std::string& config_path);
-
-/// The records the table of a study is made of, from this process's `mine` (the seeds of
-/// part.seeds(runs, first_seed)): whole: `mine` (also written to out/records-0-of-1.tsv with --out);
-/// shard: `mine`, written to out/records-i-of-K.tsv; MPI: every rank's, merged, at rank 0 and none
-/// at the others.
-std::vector<eval::StudyRecord> study_records(const StudyPart& part, std::vector<eval::StudyRecord> mine, int runs,
-                                           std::uint64_t first_seed, const std::string& out);
 
 /// The table's rows of merged records: a row per cell, in order; its scores the average of its runs
 /// in seed order (eval::summarize); failed when one of its runs failed (the first such seed's message);
 /// the first seed's association when the runs have one.
 std::vector<TableRow> rows_of(const std::vector<eval::StudyRecord>& records);
 
-/// The association's numbers as a record's extras, and back.
+/// The association's numbers as a record's extras.
 std::vector<std::pair<std::string, double>> association_extras(const AssociationRow& a);
 
-/// --merge: the table of the study whose record files (or directories of them) are `paths`.
+/// --merge: prints the table of the study whose record files (or directories of them) are `paths`
+/// and returns its rows.
 std::vector<TableRow> merged_rows(const std::string& program, const std::vector<std::string>& paths);
 
 }  // namespace sextant::runner

@@ -143,4 +143,34 @@ TEST_F(StudyShards, MpirunWithTwoRanksPrintsTheTableOfOneProcess) {
 #endif
 }
 
+/// The table lines of a study program (Markdown rows after the header), without the last column
+/// (run times).
+std::vector<std::string> study_rows(const std::string& output) {
+  std::vector<std::string> rows;
+  std::istringstream in(output);
+  for (std::string line; std::getline(in, line);)
+    if (line.starts_with("| ") && !line.starts_with("| position MAE")) rows.push_back(line.substr(0, line.rfind("| ", line.size() - 3)));
+  return rows;
+}
+
+TEST_F(StudyShards, TheGlobeStudyInShardsAndOverMpiRanksPrintsTheTableOfOneProcess) {
+  const std::string study = std::string(SEXTANT_GLOBE_STUDY_EXE) + " --runs 4 --steps 12";
+  const auto whole = run_program(study, dir);
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  ASSERT_EQ(study_rows(whole.out).size(), 1u) << whole.out;
+  for (int i = 0; i < 2; ++i) {
+    const auto r = run_program(study + " --shard " + std::to_string(i) + "/2 --out " + dir.string(), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  const auto merged = run_program(std::string(SEXTANT_GLOBE_STUDY_EXE) + " --merge " + dir.string(), dir);
+  ASSERT_EQ(merged.exit_code, 0) << merged.err;
+  EXPECT_EQ(study_rows(merged.out), study_rows(whole.out)) << merged.out << "\nagainst\n" << whole.out;
+#ifdef SEXTANT_MPIEXEC
+  const auto ranks = run_program(std::string("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 ") + SEXTANT_MPIEXEC +
+                                     " -np 2 --oversubscribe " + study, dir);
+  ASSERT_EQ(ranks.exit_code, 0) << ranks.out << ranks.err;
+  EXPECT_EQ(study_rows(ranks.out), study_rows(whole.out)) << ranks.out << "\nagainst\n" << whole.out;
+#endif
+}
+
 }  // namespace
