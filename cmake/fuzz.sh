@@ -68,6 +68,13 @@ mkdir -p "$corpus/runner_config_fuzz"
 printf '[ship]\nruns = 2\nsigma_heading_deg = 15\n[ekf]\ncovariance_update = joseph\n[seif]\nmax_active = 4 // four\n[globe]\nseif_active = 4 8\n' \
   > "$corpus/runner_config_fuzz/sextant.ini"
 
+# A Monte Carlo study's record file (eval/study_records.hpp, docs/monte_carlo_clusters.md): shard 1 of
+# 2 of a 3-run study, one run scored, one failed.
+mkdir -p "$corpus/study_records_fuzz"
+columns='dataset\tcell\tlabel\tpose_dof\tseed\tsteps\tpose_mae\tpose_rmse\tpose_rmse_aligned\tpose_mae_aligned\tmap_mae\tmap_mae_over_time\tmap_mae_aligned\tpose_nees_inside\tmap_nees_inside\tpose_anees\ttotal_seconds\tfailed_steps\tfirst_failure\tfailure\textras'
+printf "# sextant run records 1\nprogram\tsextant-run\nstudy\t--runs 3\nruns\t3\nfirst_seed\t1\nshard\t1/2\n${columns}\nship\tekf\tEKF-SLAM\t2\t2\t1390\t8.71\t12.3\t11.1\t9.33\t2.38\t2.60\t1.75\t1\t0.96\t0.587\t0.014\t1\tstep 3: update: S is not positive definite\t\tassociation_precision=0.5,b=inf\nship\tekf\tEKF-SLAM\t2\t3\t0\tnan\tnan\tnan\tnan\tnan\tnan\tnan\tnan\tnan\tnan\t0\t0\t\tfailed\t\nend\t2\n" \
+  > "$corpus/study_records_fuzz/shard"
+
 # Stereo sequences: a calibration of our own (32x24 images) with one pair, and one with a starting
 # state; the parts are separated by "%%" lines (tests/fuzz/stereo_sequence_fuzz.cpp).
 mkdir -p "$corpus/stereo_sequence_fuzz"

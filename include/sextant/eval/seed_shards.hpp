@@ -17,7 +17,10 @@ struct Shard {
   friend bool operator==(const Shard&, const Shard&) = default;
 };
 
-/// "i/K" as a shard; invalid_input_error names what is wrong (K ≥ 1, 0 ≤ i < K).
+/// The most shards a study may have (a million: far beyond any cluster's job array).
+inline constexpr int kMaxShards = 1000000;
+
+/// "i/K" as a shard; invalid_input_error names what is wrong (1 ≤ K ≤ kMaxShards, 0 ≤ i < K).
 inline Shard parse_shard(const std::string& text) {
   const auto slash = text.find('/');
   Shard s{-1, 0};
@@ -28,8 +31,9 @@ inline Shard parse_shard(const std::string& text) {
   if (slash == std::string::npos || !whole(text.data(), text.data() + slash, s.index) ||
       !whole(text.data() + slash + 1, text.data() + text.size(), s.count))
     throw invalid_input_error("shard '" + text + "': expected i/K, e.g. 0/4 for the first of 4 shards");
-  if (s.count < 1 || s.index < 0 || s.index >= s.count)
-    throw invalid_input_error("shard '" + text + "': needs K >= 1 and 0 <= i < K (shards count from 0)");
+  if (s.count < 1 || s.count > kMaxShards || s.index < 0 || s.index >= s.count)
+    throw invalid_input_error("shard '" + text + "': needs 1 <= K <= " + std::to_string(kMaxShards) +
+                              " and 0 <= i < K (shards count from 0)");
   return s;
 }
 

@@ -52,6 +52,9 @@ struct StudyRecord {
   }
 };
 
+/// The most runs a study's record file may announce (ten million).
+inline constexpr int kMaxStudyRuns = 10000000;
+
 /// The file name of a shard's records: records-i-of-K.tsv.
 inline std::string record_file_name(const Shard& shard) {
   return "records-" + std::to_string(shard.index) + "-of-" + std::to_string(shard.count) + ".tsv";
@@ -189,6 +192,7 @@ class RecordParser {
     r.cell = unescaped(f[1]);
     r.label = unescaped(f[2]);
     r.pose_dof = whole<int>(f[3], "pose_dof");
+    if (r.pose_dof < 1 || r.pose_dof > 64) fail("pose_dof: " + f[3] + " is outside 1..64");
     r.seed = whole<std::uint64_t>(f[4], "seed");
     r.scores.steps = whole<std::size_t>(f[5], "steps");
     std::size_t column = 6;
@@ -247,7 +251,10 @@ inline RecordFile parse_records(std::istream& in, const std::string& name) {
   h.program = p.keyed(in, "program");
   h.study = p.keyed(in, "study");
   h.runs = p.whole<int>(p.keyed(in, "runs"), "runs");
+  if (h.runs < 1 || h.runs > kMaxStudyRuns) p.fail("runs: " + std::to_string(h.runs) + " is outside 1.." + std::to_string(kMaxStudyRuns));
   h.first_seed = p.whole<std::uint64_t>(p.keyed(in, "first_seed"), "first_seed");
+  if (h.first_seed > std::numeric_limits<std::uint64_t>::max() - static_cast<std::uint64_t>(h.runs))
+    p.fail("first_seed: the study's seeds would pass 2^64");
   const auto shard = p.keyed(in, "shard");
   try {
     h.shard = parse_shard(shard);
@@ -305,19 +312,18 @@ inline std::vector<std::string> record_files_in(const std::string& path) {
 
 namespace detail {
 
-/// "a..b, c" for the seeds of `range` not in `present`.
+/// "a..b, c" for the seeds of `range` not in `present` (a subset of it), in time linear in `present`.
 inline std::string missing_seeds(const SeedRange& range, const std::set<std::uint64_t>& present) {
   std::string out;
-  for (int i = 0; i < range.count;) {
-    if (present.contains(range.first + static_cast<std::uint64_t>(i))) {
-      ++i;
-      continue;
-    }
-    int j = i;
-    while (j + 1 < range.count && !present.contains(range.first + static_cast<std::uint64_t>(j + 1))) ++j;
-    out += (out.empty() ? "" : ", ") + to_string(SeedRange{range.first + static_cast<std::uint64_t>(i), j - i + 1});
-    i = j + 1;
+  const auto add_gap = [&](std::uint64_t from, std::uint64_t to) {  // seeds [from, to)
+    if (from < to) out += (out.empty() ? "" : ", ") + to_string(SeedRange{from, static_cast<int>(to - from)});
+  };
+  std::uint64_t next = range.first;
+  for (const std::uint64_t seed : present) {
+    add_gap(next, seed);
+    next = seed + 1;
   }
+  add_gap(next, range.first + static_cast<std::uint64_t>(range.count));
   return out;
 }
 
@@ -384,6 +390,7 @@ inline std::vector<StudyRecord> merge_records(std::vector<RecordFile> files) {
                                 to_string(files[i].header.shard));
   }
   std::string missing;
+  int missing_count = 0;
   for (int index = 0, next = 0; index < h.shard.count; ++index) {
     if (next < static_cast<int>(files.size()) && files[next].header.shard.index == index) {
       ++next;
@@ -391,9 +398,11 @@ inline std::vector<StudyRecord> merge_records(std::vector<RecordFile> files) {
     }
     const Shard shard{index, h.shard.count};
     if (seeds_of(shard, h.runs, h.first_seed).count == 0) continue;  // an empty shard may write no file
-    missing += (missing.empty() ? "" : "; ") + record_file_name(shard) + " (seeds " +
-               to_string(seeds_of(shard, h.runs, h.first_seed)) + ")";
+    if (++missing_count <= 5)
+      missing += (missing.empty() ? "" : "; ") + record_file_name(shard) + " (seeds " +
+                 to_string(seeds_of(shard, h.runs, h.first_seed)) + ")";
   }
+  if (missing_count > 5) missing += "; and " + std::to_string(missing_count - 5) + " more";
   if (!missing.empty())
     throw invalid_input_error("the study of " + files.front().name + " misses shard files: " + missing);
   const auto holding = std::find_if(files.begin(), files.end(), [](const RecordFile& f) { return !f.records.empty(); });
