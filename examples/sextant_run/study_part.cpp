@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -14,9 +15,12 @@
 namespace sextant::runner {
 namespace {
 
-/// FNV-1a of a file's bytes, as hex; "none" without a file.
+/// FNV-1a of a file's bytes, as hex; "none" without a file, "unreadable" for what is not a regular
+/// file (the config's reader then says what is wrong with it).
 std::string file_hash(const std::string& path) {
   if (path.empty()) return "none";
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return "unreadable";
   std::ifstream in(path, std::ios::binary);
   std::uint64_t h = 1469598103934665603ull;
   for (std::istreambuf_iterator<char> it(in), end; it != end; ++it) {
