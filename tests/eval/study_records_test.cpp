@@ -64,6 +64,14 @@ RunSummary<Eigen::Vector2d> random_run(std::mt19937_64& rng, std::size_t steps) 
   return r;
 }
 
+/// `count` random runs of 5 steps from generator seed `seed`.
+std::vector<RunSummary<Eigen::Vector2d>> random_runs(std::uint64_t seed, int count) {
+  std::mt19937_64 rng(seed);
+  std::vector<RunSummary<Eigen::Vector2d>> runs;
+  for (int i = 0; i < count; ++i) runs.push_back(random_run(rng, 5));
+  return runs;
+}
+
 std::vector<StudyRecord> records_of(const std::vector<RunSummary<Eigen::Vector2d>>& runs, std::uint64_t first_seed) {
   std::vector<StudyRecord> records;
   for (std::size_t i = 0; i < runs.size(); ++i)
@@ -194,9 +202,7 @@ std::string merge_error_of(std::vector<RecordFile> files) {
 }
 
 TEST(StudyRecords, MergeRefusesAMissingShardNamingItsFileAndSeeds) {
-  std::mt19937_64 rng(2);
-  std::vector<RunSummary<Eigen::Vector2d>> runs;
-  for (int i = 0; i < 9; ++i) runs.push_back(random_run(rng, 5));
+  const auto runs = random_runs(2, 9);
   auto files = written_and_read(records_of(runs, 1), 3);  // shards 2, 1, 0
   files.erase(files.begin() + 1);
   EXPECT_NE(merge_error_of(files).find("misses shard files: records-1-of-3.tsv (seeds 4..6)"), std::string::npos)
@@ -204,9 +210,7 @@ TEST(StudyRecords, MergeRefusesAMissingShardNamingItsFileAndSeeds) {
 }
 
 TEST(StudyRecords, MergeRefusesAShardThatLacksRunsNamingTheFileAndSeeds) {
-  std::mt19937_64 rng(3);
-  std::vector<RunSummary<Eigen::Vector2d>> runs;
-  for (int i = 0; i < 9; ++i) runs.push_back(random_run(rng, 5));
+  const auto runs = random_runs(3, 9);
   auto files = written_and_read(records_of(runs, 1), 3);
   files[1].records.erase(files[1].records.begin());  // shard 1 without seed 4
   EXPECT_NE(merge_error_of(files).find("records-1-of-3.tsv: ship/ekf lacks seeds 4 of shard 1/3"), std::string::npos)
@@ -221,9 +225,7 @@ TEST(StudyRecords, MergeRefusesAShardThatLacksRunsNamingTheFileAndSeeds) {
 }
 
 TEST(StudyRecords, MergeRefusesShardsOfAnotherStudyOrTheSameShardTwice) {
-  std::mt19937_64 rng(4);
-  std::vector<RunSummary<Eigen::Vector2d>> runs;
-  for (int i = 0; i < 4; ++i) runs.push_back(random_run(rng, 5));
+  const auto runs = random_runs(4, 4);
   auto files = written_and_read(records_of(runs, 1), 2);
   auto other = written_and_read(records_of(runs, 1), 2, "--runs 4 -c other.ini");
   files[0] = other[0];
