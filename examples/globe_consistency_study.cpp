@@ -20,9 +20,9 @@ namespace {
 using namespace sextant;
 
 /// One seed: the EKF through the pool, scored as the consistency test scores it.
-eval::StudyRecord globe_run(std::uint64_t seed, int steps) {
+eval::StudyRecord globe_run(std::uint64_t seed, int steps, const EkfOptions& options) {
   const auto data = sim::simulate_globe_camera({.seed = seed, .num_steps = steps});
-  EkfSlam<EulerCamera12D, PointInCamera3D> ekf(data.motion, data.sensor, data.prior);
+  EkfSlam<EulerCamera12D, PointInCamera3D> ekf(data.motion, data.sensor, data.prior, options);
   const auto run = eval::run_through_pool(ekf, data.steps, {.max_landmarks = 1000, .max_new_per_step = 50}, 1,
                                           [](std::size_t, const auto&) {});
   const auto s = eval::score_camera(run.means, run.poses, data.true_poses, ekf.map(), data.true_landmarks);
@@ -54,10 +54,15 @@ int main(int argc, char** argv) {
   study.add_to(app);
   int steps = 500;
   app.add_option("--steps", steps, "steps per run (thesis: 500)")->check(CLI::Range(2, 100000))->capture_default_str();
+  EkfOptions ekf;
+  app.add_flag("--first-estimates", ekf.first_estimate_jacobians,
+               "first-estimate Jacobians for the landmarks (EkfOptions::first_estimate_jacobians)");
+  app.add_flag("--observability-constraints", ekf.observability_constraints,
+               "OC-EKF: Jacobians that keep the world's rigid motions unobservable (EkfOptions::observability_constraints)");
   CLI11_PARSE(app, argc, argv);
   try {
     runner::StudyRun run("sextant-globe-study", study, argc, argv);
-    run.add_cell([&](std::uint64_t seed) { return globe_run(seed, steps); });
+    run.add_cell([&](std::uint64_t seed) { return globe_run(seed, steps, ekf); });
     const auto records = run.finish();
     if (records.empty()) return 0;  // an MPI rank other than 0
     const auto s = eval::summarize(runner::scores_of(records), 3);
@@ -68,7 +73,9 @@ int main(int argc, char** argv) {
       rotation_mae += r.extra("rotation_mae") / static_cast<double>(records.size());
       seconds.push_back(r.scores.total_seconds);
     }
-    std::printf("Globe, EKF-SLAM, %d runs (seeds %llu..%llu), %zu steps each%s\n\n", static_cast<int>(records.size()),
+    std::printf("Globe, EKF-SLAM%s%s, %d runs (seeds %llu..%llu), %zu steps each%s\n\n",
+                ekf.first_estimate_jacobians ? ", first-estimate Jacobians" : "",
+                ekf.observability_constraints ? ", observability constraints" : "", static_cast<int>(records.size()),
                 static_cast<unsigned long long>(records.front().seed), static_cast<unsigned long long>(records.back().seed),
                 records.front().scores.steps,
                 run.part().mode == runner::StudyPart::Mode::shard ? " (this shard's seeds only)" : "");

@@ -31,9 +31,18 @@ struct BackendChoice {
 /// `automatic` means on for the planar world-frame chart (Se2WorldSpace), where the textbook EKF is
 /// inconsistent (docs/design_notes.md), and off elsewhere.
 template <class Motion>
-bool use_first_estimates(FirstEstimates choice) {
-  if (choice == FirstEstimates::automatic) return std::is_same_v<typename Motion::Space, Se2WorldSpace>;
-  return choice == FirstEstimates::on;
+bool use_first_estimates(AutoSwitch choice) {
+  if (choice == AutoSwitch::automatic) return std::is_same_v<typename Motion::Space, Se2WorldSpace>;
+  return choice == AutoSwitch::on;
+}
+
+/// Whether a filter keeps observability constraints (RunnerConfig::ekf_observability_constraints,
+/// seif_observability_constraints): `automatic` means on where Motion's state space names the
+/// world's rigid motions (the 12D camera), which no other model pair does.
+template <class Motion>
+bool use_observability_constraints(AutoSwitch choice) {
+  if (choice == AutoSwitch::automatic) return has_world_motion_directions_v<typename Motion::Space>;
+  return choice == AutoSwitch::on;
 }
 
 /// One choice per kind, as the config sets it: the first-estimate policy for Motion's chart and
@@ -45,6 +54,8 @@ std::vector<BackendChoice> backend_choices(const std::vector<BackendKind>& kinds
     BackendChoice choice{kind, backend_key(kind), backend_label(kind, c), c.ekf, c.seif, c.graph, c.fastslam};
     choice.ekf.first_estimate_jacobians = use_first_estimates<Motion>(c.ekf_first_estimates);
     choice.seif.first_estimate_jacobians = use_first_estimates<Motion>(c.seif_first_estimates);
+    choice.ekf.observability_constraints = use_observability_constraints<Motion>(c.ekf_observability_constraints);
+    choice.seif.observability_constraints = use_observability_constraints<Motion>(c.seif_observability_constraints);
     choice.fastslam.version = kind == BackendKind::fastslam1 ? FastSlamVersion::v1 : FastSlamVersion::v2;
     choices.push_back(std::move(choice));
   }

@@ -67,19 +67,23 @@ struct AssociationSettings {
   AssociationOptions options;
 };
 
-/// [ekf] and [seif] first_estimate_jacobians: automatic turns them on where the pose is perturbed in the world
-/// frame ([mrclam] filters_in_world_frame), the chart in which they keep the global pose
-/// unobservable; in the additive chart they would also need the motion Jacobian at first estimates,
-/// and alone they make the EKF worse (docs/results/mrclam.md).
-enum class FirstEstimates { automatic, on, off };
+/// A filter setting that `automatic` turns on where it helps, from the models (backend_factory.hpp):
+/// [ekf] and [seif] first_estimate_jacobians where the pose is perturbed in the world frame ([mrclam]
+/// filters_in_world_frame), the chart in which they keep the global pose unobservable (in the
+/// additive chart they would also need the motion Jacobian at first estimates, and alone they make
+/// the EKF worse, docs/results/mrclam.md); observability_constraints where the state space names the
+/// world's rigid motions (the globe's 12D camera, docs/derivations/observability_constraints.md).
+enum class AutoSwitch { automatic, on, off };
 
 struct RunnerConfig {
   sim::Ship2DOptions ship;
   int ship_runs = 10;
   mrpt_io::RawlogOptions rawlog;
   EkfOptions ekf;
-  FirstEstimates ekf_first_estimates = FirstEstimates::automatic;
-  FirstEstimates seif_first_estimates = FirstEstimates::automatic;
+  AutoSwitch ekf_first_estimates = AutoSwitch::automatic;
+  AutoSwitch seif_first_estimates = AutoSwitch::automatic;
+  AutoSwitch ekf_observability_constraints = AutoSwitch::automatic;
+  AutoSwitch seif_observability_constraints = AutoSwitch::automatic;
   SeifOptions seif{.max_active = 8};
   GraphOptions graph;
   FastSlamOptions fastslam{.particles = 100, .resample_threshold = 0.1, .map_estimate = FastSlamMap::weighted_average};
@@ -174,9 +178,8 @@ Enum parse_choice(const std::string& text, std::initializer_list<std::pair<const
   throw invalid_input_error("'" + text + "' is not one of " + names);
 }
 
-inline FirstEstimates parse_first_estimates(const std::string& text) {
-  return parse_choice<FirstEstimates>(
-      text, {{"auto", FirstEstimates::automatic}, {"true", FirstEstimates::on}, {"false", FirstEstimates::off}});
+inline AutoSwitch parse_auto_switch(const std::string& text) {
+  return parse_choice<AutoSwitch>(text, {{"auto", AutoSwitch::automatic}, {"true", AutoSwitch::on}, {"false", AutoSwitch::off}});
 }
 
 }  // namespace detail
@@ -322,7 +325,11 @@ inline const std::vector<ConfigKey>& config_keys() {
        }},
       {"ekf", "first_estimate_jacobians", "auto",
        "auto (on where the pose is perturbed in the world frame: MRCLAM) | true | false",
-       [](RunnerConfig& c, const std::string& v) { c.ekf_first_estimates = parse_first_estimates(v); }},
+       [](RunnerConfig& c, const std::string& v) { c.ekf_first_estimates = parse_auto_switch(v); }},
+      {"ekf", "observability_constraints", "auto",
+       "auto (on where the state space names the world's rigid motions: the globe) | true | false: OC-EKF "
+       "(docs/derivations/observability_constraints.md)",
+       [](RunnerConfig& c, const std::string& v) { c.ekf_observability_constraints = parse_auto_switch(v); }},
       {"ekf", "gate_probability", "0", "Mahalanobis gate: reject observations above this chi-square quantile; 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.ekf.gate_probability = parse_gate_probability(v); }},
       {"ekf", "tangent_reset", "false",
@@ -331,7 +338,10 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.ekf.tangent_reset = parse_bool(v); }},
       {"seif", "first_estimate_jacobians", "auto",
        "auto (on where the pose is perturbed in the world frame: MRCLAM) | true | false",
-       [](RunnerConfig& c, const std::string& v) { c.seif_first_estimates = parse_first_estimates(v); }},
+       [](RunnerConfig& c, const std::string& v) { c.seif_first_estimates = parse_auto_switch(v); }},
+      {"seif", "observability_constraints", "auto",
+       "auto (on where the state space names the world's rigid motions: the globe) | true | false",
+       [](RunnerConfig& c, const std::string& v) { c.seif_observability_constraints = parse_auto_switch(v); }},
       {"seif", "gate_probability", "0",
        "Mahalanobis gate with the exact marginals (one factorization per update); 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.seif.gate_probability = parse_gate_probability(v); }},

@@ -7,6 +7,7 @@
 #include <numbers>
 #include <random>
 
+#include "sextant/core/observability_constraints.hpp"
 #include "sextant/testing/model_checks.hpp"
 
 namespace sextant {
@@ -145,6 +146,91 @@ TEST(PointInCamera3D, MeasuresThePointInTheCameraFrameAndInvertsIt) {
   EXPECT_TRUE(sensor.initialize(x, prediction.z).m.isApprox(Eigen::Vector3d(3.0, 2.0, 3.0), 1e-12));
   // Depth noise exceeds the lateral noise: the covariance is anisotropic.
   EXPECT_GT(prediction.Q(2, 2), 10.0 * prediction.Q(0, 0));
+}
+
+}  // namespace
+}  // namespace sextant
+
+namespace sextant {
+namespace {
+
+/// The state after moving the world by translation t and rotation Exp(w) (exact, not linearized).
+Vector12d moved_world(const Vector12d& x, const Eigen::Vector3d& t, const Eigen::Vector3d& w) {
+  const Eigen::Matrix3d Rw = so3::exp(w);
+  Vector12d out = x;
+  out.head<3>() = Rw * x.head<3>() + t;
+  // the Euler angles of Exp(w) R(eta): eta + d with R(eta + d) = Exp(w) R(eta), solved by Newton
+  Eigen::Vector3d eta = x.segment<3>(3);
+  const Eigen::Matrix3d target = Rw * euler_yxz::rotation(eta);
+  for (int i = 0; i < 20; ++i)
+    eta += euler_yxz::rate_matrix(eta) * so3::log(euler_yxz::rotation(eta).transpose() * target);
+  out.segment<3>(3) = eta;
+  return out;
+}
+
+TEST(EulerCamera12D, WorldMotionDirectionsAreTheDerivativeOfMovingTheWorldAndLeaveMeasurementsAlone) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  PointInCamera3D sensor;
+  EulerCamera12D motion;
+  motion.gamma << 0.9, 0.95, 1.0;
+  motion.lambda << 0.8, 1.0, 0.7;
+  for (double phi : {0.0, 0.4, -1.2})
+    for (int trial = 0; trial < 10; ++trial) {
+      const Vector12d x = random_state(rng, phi);
+      const Eigen::Vector3d l(2 + u(rng), u(rng), u(rng));
+      const auto N = EulerCamera12Space::world_motion_directions(x);
+      const auto N_l = point_world_motion_directions(l);
+      constexpr double h = 1e-6;
+      for (int k = 0; k < 6; ++k) {  // each column against the exact motion, by central differences
+        Eigen::Matrix<double, 6, 1> e = Eigen::Matrix<double, 6, 1>::Unit(k);
+        const Vector12d plus = moved_world(x, h * e.head<3>(), h * e.tail<3>());
+        const Vector12d minus = moved_world(x, -h * e.head<3>(), -h * e.tail<3>());
+        EXPECT_LT((EulerCamera12Space::minus(plus, minus) / (2 * h) - N.col(k)).norm(), 1e-6) << "column " << k;
+      }
+      // moving the world leaves the measurement of a moved landmark the same ...
+      const Eigen::Vector3d t(u(rng), u(rng), u(rng)), w(0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng));
+      const Vector12d x_moved = moved_world(x, t, w);
+      const Eigen::Vector3d l_moved = so3::exp(w) * l + t;
+      EXPECT_LT((sensor.predict(x_moved, l_moved).z - sensor.predict(x, l).z).norm(), 1e-9);
+      // ... so H N = 0 at one linearization point; the motion maps N(x) onto N(g(x)) up to the
+      // Euler-angle integration's O(dt^2) (eta' = eta + J(eta) omega dt is first order): halving dt
+      // must divide the mismatch by about 4 (at least 3)
+      const auto m = sensor.predict(x, l);
+      EXPECT_LT((m.J_z_x * N + m.J_z_m * N_l).norm(), 1e-9);
+      const auto mismatch = [&](double dt) {
+        const auto g = motion.predict(x, {}, dt);
+        return (g.J_x_x * N - EulerCamera12Space::world_motion_directions(g.x)).norm();
+      };
+      EXPECT_GT(mismatch(0.02) / mismatch(0.01), 3.0) << mismatch(0.02) << " against " << mismatch(0.01);
+    }
+}
+
+TEST(ObservabilityConstraints, TheNearestJacobiansThatKeepTheWorldsMotionsUnobservable) {
+  std::mt19937_64 rng(12);
+  const Vector12d x_prev = random_state(rng, 0.3), x_next = random_state(rng, -0.2), x_far = random_state(rng, 0.5);
+  const auto N_prev = EulerCamera12Space::world_motion_directions(x_prev);
+  const auto N_next = EulerCamera12Space::world_motion_directions(x_next);
+  const Matrix12d G = Matrix12d::Random();
+  const Matrix12d G_star = constrained_transition<12, 6>(G, N_prev, N_next);
+  EXPECT_LT((G_star * N_prev - N_next).norm(), 1e-10);
+  // nearest: the change lies in the rows' span of N_prev^T (it is orthogonal to what N_prev does not reach)
+  const Eigen::Matrix<double, 12, 6> basis = N_prev.householderQr().householderQ() * Eigen::Matrix<double, 12, 6>::Identity();
+  const Matrix12d projector = basis * basis.transpose();
+  EXPECT_LT(((G_star - G) * (Matrix12d::Identity() - projector)).norm(), 1e-10);
+  EXPECT_LT((constrained_transition<12, 6>(G_star, N_prev, N_next) - G_star).norm(), 1e-10) << "idempotent";
+
+  LinearizedObservation<3, 12, 3> lin{7, 12, Eigen::Matrix<double, 3, 12>::Random(), Eigen::Matrix3d::Random(),
+                                      Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
+  const Eigen::Vector3d l(3.0, -1.0, 0.5);
+  const auto N_x = EulerCamera12Space::world_motion_directions(x_far);
+  constrain_observation(lin, N_x, point_world_motion_directions(l));
+  EXPECT_LT((lin.J_z_x * N_x + lin.J_z_m * point_world_motion_directions(l)).norm(), 1e-10);
+  // an H that already has the null space is left as it is
+  const auto exact = PointInCamera3D{}.predict(x_far, l);
+  LinearizedObservation<3, 12, 3> same{7, 12, exact.J_z_x, exact.J_z_m, exact.Q, Eigen::Vector3d::Zero()};
+  constrain_observation(same, N_x, point_world_motion_directions(l));
+  EXPECT_LT((same.J_z_x - exact.J_z_x).norm() + (same.J_z_m - exact.J_z_m).norm(), 1e-9);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "sextant/core/rollback_guard.hpp"
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/first_estimates.hpp"
+#include "sextant/core/observability_constraints.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/innovation_gate.hpp"
 #include "sextant/core/joint_marginal.hpp"
@@ -51,6 +52,11 @@ struct EkfOptions {
   /// of the unobservable subspace that first-estimate Jacobians keep fixed, and measured it costs
   /// more than it brings (MRCLAM world chart with first estimates: 0.28-0.45 m -> 0.40-4.5 m).
   bool tangent_reset = false;
+  /// Observability constraints (OC-EKF, core/observability_constraints.hpp): the robot's transition
+  /// and every observation's Jacobian are replaced by the nearest ones that keep the world's rigid
+  /// motions unobservable, as they are. Needs a state space that names them
+  /// (Space::world_motion_directions; the 12D camera does) and point landmarks.
+  bool observability_constraints = false;
 };
 
 /// EKF-SLAM: joint Gaussian over the robot state and a growing set of landmarks. Only the lower
@@ -152,6 +158,7 @@ class EkfSlam {
   EkfOptions options_;
   InnovationGate gate_;
   State x_;
+  State propagated_;  ///< the robot state after the last prediction (observability constraints)
   LandmarkStore<M> landmarks_;  ///< ids, slots, means and first means (first_estimate_jacobians)
   GrowableSquareMatrix cov_;     ///< P; only its lower triangle is kept up to date
 };

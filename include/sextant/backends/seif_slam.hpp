@@ -16,6 +16,7 @@
 #include "sextant/core/landmark_store.hpp"
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/first_estimates.hpp"
+#include "sextant/core/observability_constraints.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/innovation_gate.hpp"
 #include "sextant/core/joint_marginal.hpp"
@@ -51,6 +52,9 @@ struct SeifOptions {
   /// EkfOptions::first_estimate_jacobians: with the pose perturbed in the world frame the information
   /// added then never reaches the unobservable global pose. Off: the thesis's SEIF.
   bool first_estimate_jacobians = false;
+  /// Observability constraints, as EkfOptions::observability_constraints (OC-EKF in information form:
+  /// the constrained G and H enter the motion and measurement updates unchanged otherwise).
+  bool observability_constraints = false;
 };
 
 /// Wall time of one update's stages, as the thesis times them (§5.4, Tables 15-16): measurement
@@ -185,6 +189,7 @@ class SeifSlam {
   SeifOptions options_;
   InnovationGate gate_;
   State x_;
+  State propagated_;  ///< the robot state after the last prediction (observability constraints)
   SparseInformation<X, M> info_;
   LandmarkStore<M> landmarks_;  ///< ids, slots, means and first means (first_estimate_jacobians)
   SeifUpdateTimes last_update_times_;

@@ -124,6 +124,17 @@ struct EulerCamera12Space {
     return out;
   }
   static bool is_finite(const Point& x) { return x.allFinite(); }
+  /// The world's rigid motions at x (core/observability_constraints.hpp), columns translation then
+  /// rotation about the world's axes: a motion (t, w) moves p by t + w x p and turns R(eta) into
+  /// Exp(w) R(eta), i.e. eta by J(eta) R(eta)^T w; v and omega, in the camera frame, stay.
+  static Eigen::Matrix<double, 12, 6> world_motion_directions(const Point& x) {
+    Eigen::Matrix<double, 12, 6> N = Eigen::Matrix<double, 12, 6>::Zero();
+    const Eigen::Vector3d eta = x.segment<3>(3);
+    N.block<3, 3>(0, 0).setIdentity();
+    N.block<3, 3>(0, 3) = -so3::hat(x.head<3>());
+    N.block<3, 3>(3, 3) = euler_yxz::rate_matrix(eta) * euler_yxz::rotation(eta).transpose();
+    return N;
+  }
 };
 
 /// Constant-velocity camera (eq. 101): p' = p + R(eta) v dt, eta' = eta + J(eta) omega dt,

@@ -13,8 +13,10 @@ namespace sextant {
 
 template <class Motion, class Sensor>
 EkfSlam<Motion, Sensor>::EkfSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, EkfOptions options)
-    : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), x_(prior.mean), cov_(X) {
+    : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), x_(prior.mean), propagated_(prior.mean),
+      cov_(X) {
   if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
+  require_constrainable<Space, Landmark>(options_.observability_constraints);
   cholesky_or_throw(prior.cov, "prior covariance");
   gate_ = InnovationGate(Z, options_.gate_probability);
   cov_.view() = symmetrized(prior.cov);
@@ -28,7 +30,8 @@ void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   require_positive_time_step(dt);
   const auto prediction = checked_motion_prediction(motion_, x_, u, dt);
   auto P = cov_.view();
-  const auto& G = prediction.J_x_x;
+  const Eigen::Matrix<double, X, X> G =
+      robot_transition<Space, X>(options_.observability_constraints, prediction.J_x_x, propagated_, prediction.x);
   const Eigen::Index rest = P.rows() - X;
   const Eigen::Matrix<double, X, X> P_xx = symmetrized(G * symmetric_diagonal_block<X>(P, 0) * G.transpose() + prediction.R);
   const Eigen::MatrixXd P_mx = P.bottomLeftCorner(rest, X) * G.transpose();
@@ -36,7 +39,9 @@ void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   P.template topLeftCorner<X, X>() = P_xx;
   P.bottomLeftCorner(rest, X) = P_mx;
   x_ = prediction.x;
+  propagated_ = prediction.x;
 }
+
 
 /// Batch mode: one joint correction, planned in full before anything changes. Sequential mode:
 /// one correction per observation on a snapshot that is restored if any step throws.
@@ -69,6 +74,8 @@ auto EkfSlam<Motion, Sensor>::linearize(std::span<const ObservationType> known, 
     if (!lin) continue;
     if (options_.first_estimate_jacobians)
       use_first_estimate_jacobians(sensor_, x_, Landmark(landmarks_.first_mean(slot)), observation.z, *lin);
+    constrain_observation_if<Space>(options_.observability_constraints, *lin, propagated_,
+                                    Landmark(landmarks_.first_mean(slot)));
     out.push_back(std::move(*lin));
   }
   return out;

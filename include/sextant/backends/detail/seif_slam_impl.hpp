@@ -16,7 +16,8 @@ namespace sextant {
 
 template <class Motion, class Sensor>
 SeifSlam<Motion, Sensor>::SeifSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, SeifOptions options)
-    : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), x_(prior.mean) {
+    : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), x_(prior.mean), propagated_(prior.mean) {
+  require_constrainable<Space, Landmark>(options_.observability_constraints);
   if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
   const auto llt = cholesky_or_throw(prior.cov, "prior covariance");
   info_.robot() = symmetrized(llt.solve(Eigen::Matrix<double, X, X>::Identity()));
@@ -38,10 +39,12 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   require_finite(u, "control");
   require_positive_time_step(dt);
   const auto prediction = checked_motion_prediction(motion_, x_, u, dt);
-  const auto singular_values = Eigen::JacobiSVD<MatrixX>(prediction.J_x_x).singularValues();
+  const MatrixX G =
+      robot_transition<Space, X>(options_.observability_constraints, prediction.J_x_x, propagated_, prediction.x);
+  const auto singular_values = Eigen::JacobiSVD<MatrixX>(G).singularValues();
   if (!(singular_values(X - 1) > 1e-12 * singular_values(0)))
     throw numerical_error("motion Jacobian G is singular; the SEIF motion update needs G^-1");
-  const MatrixX G_inv_T = prediction.J_x_x.partialPivLu().solve(MatrixX::Identity()).transpose();  // conditioning checked above
+  const MatrixX G_inv_T = G.partialPivLu().solve(MatrixX::Identity()).transpose();  // conditioning checked above
   const MatrixX Phi_xx = symmetrized(G_inv_T * info_.robot() * G_inv_T.transpose());
   const MatrixX T = symmetrized(
       (MatrixX::Identity() + prediction.R * Phi_xx).partialPivLu().solve(prediction.R));
@@ -67,6 +70,7 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
     x_ = prediction.x;
     require_factorizable_robot_and_active("SEIF motion update");
   });
+  propagated_ = prediction.x;
 }
 
 /// One observation linearized at the current estimate (H at the first estimate if so configured).
@@ -78,6 +82,9 @@ auto SeifSlam<Motion, Sensor>::linearize(const ObservationType& observation, std
                                      offset_of(slot), unusable);
   if (lin && options_.first_estimate_jacobians)
     use_first_estimate_jacobians(sensor_, x_, Landmark(landmarks_.first_mean(slot)), observation.z, *lin);
+  if (lin)
+    constrain_observation_if<Space>(options_.observability_constraints, *lin, propagated_,
+                                    Landmark(landmarks_.first_mean(slot)));
   return lin;
 }
 
