@@ -87,8 +87,11 @@ std::vector<eval::StudyRecord> study_records(const StudyPart& part, std::vector<
     std::ostringstream text;
     eval::write_records(text, header, mine);
     auto all = gathered_records(text.str());
-    if (part.prints() && !out.empty())  // rank 0: the whole study's records, as one process would write them
-      std::printf("wrote %s\n", eval::write_record_file(out, {part.program, part.study, runs, first_seed, {}}, all).c_str());
+    if (part.prints() && !out.empty()) {  // rank 0: the whole study's records, as one process would write them
+      eval::StudyHeader whole = header;
+      whole.shard = {};
+      std::printf("wrote %s\n", eval::write_record_file(out, whole, all).c_str());
+    }
     return all;
   }
   if (!out.empty()) std::printf("wrote %s\n", eval::write_record_file(out, header, mine).c_str());
