@@ -23,6 +23,10 @@ seed() {
 seed isam_reader_fuzz "$shared/city_trees/cityTrees10000.txt" 4096
 seed isam_reader_fuzz "$shared/city_trees/cityTrees10000_groundtruth.txt" 4096
 seed isam_reader_fuzz "$shared/victoria_park/victoria_park.txt" 4096
+seed pose_graph_file_fuzz "$shared/pose_graphs/intel.g2o" 4096
+seed pose_graph_file_fuzz "$shared/pose_graphs/sphere2500.g2o" 4096
+seed pose_graph_file_fuzz "$shared/pose_graphs/manhattan.g2o" 2048
+seed pose_graph_file_fuzz "$mrpt/datasets/graph_2d_circle_50nodes.graph"
 for f in "$mrpt"/datasets/kf-slam_*ground_truth*.txt; do seed kf_slam_ground_truth_fuzz "$f" 4096; done
 for f in "$mrpt"/datasets/kf-slam_demo.rawlog "$mrpt"/datasets/kf-slam_6D_demo.rawlog; do seed rawlog_fuzz "$f"; done
 for f in "$mrpt"/config_files/kf-slam/EKF-SLAM_test_2d.ini "$mrpt"/config_files/kf-slam/EKF-SLAM_6D_test.ini; do

@@ -20,6 +20,7 @@
 #include <sextant/backends/ekf_slam.hpp>
 #include <sextant/backends/fast_slam.hpp>
 #include <sextant/backends/graph_slam.hpp>
+#include <sextant/backends/pose_graph.hpp>
 #include <sextant/backends/seif_slam.hpp>
 #include <sextant/core/data_association.hpp>
 #include <sextant/core/error.hpp>
@@ -75,6 +76,13 @@ struct AssociationSettings {
 /// world's rigid motions (the globe's 12D camera, docs/derivations/observability_constraints.md).
 enum class AutoSwitch { automatic, on, off };
 
+/// Where a pose graph's optimization starts ([pose_graph] start).
+enum class PoseGraphStart {
+  file,           ///< the file's vertices (a spanning tree of the odometry when it has none)
+  spanning_tree,  ///< PoseGraph::initialize_by_spanning_tree
+  chordal,        ///< PoseGraph::initialize_by_chordal_relaxation
+};
+
 struct RunnerConfig {
   sim::Ship2DOptions ship;
   int ship_runs = 10;
@@ -86,6 +94,8 @@ struct RunnerConfig {
   AutoSwitch seif_observability_constraints = AutoSwitch::automatic;
   SeifOptions seif{.max_active = 8};
   GraphOptions graph;
+  PoseGraphOptions pose_graph;
+  PoseGraphStart pose_graph_start = PoseGraphStart::file;
   FastSlamOptions fastslam{.particles = 100, .resample_threshold = 0.1, .map_estimate = FastSlamMap::weighted_average};
   GlobeSettings globe;
   VislamSettings vislam;
@@ -375,6 +385,31 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.graph.levenberg_marquardt = parse_bool(v); }},
       {"graph", "window", "0", "windowed initialization: optimize growing parts of this many steps first; 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.graph.window = parse_integer<std::size_t>(v, 0); }},
+      {"pose_graph", "start", "file", "file (its vertices) | spanning_tree (of the odometry) | chordal (relaxation)",
+       [](RunnerConfig& c, const std::string& v) {
+         c.pose_graph_start = parse_choice<PoseGraphStart>(
+             v, {{"file", PoseGraphStart::file}, {"spanning_tree", PoseGraphStart::spanning_tree}, {"chordal", PoseGraphStart::chordal}});
+       }},
+      {"pose_graph", "loop_closure_kernel", "none", "none | huber | cauchy, on edges between non-consecutive poses",
+       [](RunnerConfig& c, const std::string& v) {
+         c.pose_graph.loop_closure_loss.kernel = parse_choice<RobustKernel>(
+             v, {{"none", RobustKernel::none}, {"huber", RobustKernel::huber}, {"cauchy", RobustKernel::cauchy}});
+       }},
+      {"pose_graph", "odometry_kernel", "none", "none | huber | cauchy, on edges between consecutive poses",
+       [](RunnerConfig& c, const std::string& v) {
+         c.pose_graph.odometry_loss.kernel = parse_choice<RobustKernel>(
+             v, {{"none", RobustKernel::none}, {"huber", RobustKernel::huber}, {"cauchy", RobustKernel::cauchy}});
+       }},
+      {"pose_graph", "kernel_width", "2.4477", "robust kernel width, standard deviations of the whitened residual",
+       [](RunnerConfig& c, const std::string& v) {
+         c.pose_graph.loop_closure_loss.width = c.pose_graph.odometry_loss.width = positive(parse_number(v), v);
+       }},
+      {"pose_graph", "outlier_gate_probability", "0",
+       "after the robust optimization, edges with a kernel beyond this chi-square quantile are dropped and the rest "
+       "solved again by least squares; 0 = off (docs/results/pose_graphs.md: cauchy, width 1, 0.999)",
+       [](RunnerConfig& c, const std::string& v) { c.pose_graph.outlier_gate_probability = parse_gate_probability(v); }},
+      {"pose_graph", "max_iterations", "100", "Levenberg-Marquardt iterations at most",
+       [](RunnerConfig& c, const std::string& v) { c.pose_graph.max_iterations = parse_integer<int>(v, 0, 1e6); }},
       {"fastslam", "gate_probability", "0", "per-particle Mahalanobis gate on known landmarks; 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.fastslam.gate_probability = parse_gate_probability(v); }},
       {"fastslam", "particles", "100", "particles",

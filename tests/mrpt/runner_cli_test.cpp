@@ -2,6 +2,8 @@
 // and bad input (missing, truncated or malformed rawlog, unknown config key or value) ends with a
 // non-zero exit and one line naming the file and the problem.
 #include <gtest/gtest.h>
+
+#include <sextant/io/pose_graph_file.hpp>
 #include <unistd.h>
 
 #include <cmath>
@@ -367,6 +369,31 @@ TEST_F(RunnerCli, IsamTextWithoutGroundTruthIsTimedAndWrittenNotScored) {
   std::stringstream text;
   text << json.rdbuf();
   EXPECT_NE(text.str().find("\"pose_mae\": null"), std::string::npos) << text.str();
+}
+
+/// A g2o file goes to sextant-pose-graph: its size, chi2 before and after, the optimized graph
+/// written as g2o (read back at the printed chi2); a malformed file is one line naming file:line.
+TEST_F(RunnerCli, PoseGraphFileIsOptimizedAndWrittenBack) {
+  const auto data = (dir / "square.g2o").string();
+  std::ofstream file(data);
+  const char* info = " 100 0 0 100 0 400\n";
+  for (int k = 0; k < 8; ++k) file << "VERTEX_SE2 " << k << " " << 0.1 * k << " " << -0.05 * k << " " << 0.2 * k << "\n";
+  for (int k = 0; k < 8; ++k)  // a square driven twice, the last edge closing the loop
+    file << "EDGE_SE2 " << k << " " << (k + 1) % 8 << " 1 0 " << (k % 2 ? "1.5707963" : "0") << info;
+  file.close();
+  const auto out = dir / "pose_graph_out";
+  const auto r = run_runner("-d " + data + " -o " + out.string(), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("2D g2o pose graph (SE(2)): 8 poses, 0 points; 8 edges: 7 odometry, 1 loop closures"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| the file's vertices |"), std::string::npos) << r.out;
+  const auto written = out / "square_optimized.g2o";
+  ASSERT_TRUE(fs::exists(written)) << r.out;
+  const auto read = sextant::io::read_pose_graph(written.string());
+  char chi2[64];
+  std::snprintf(chi2, sizeof chi2, "| %.10g |", read.planar.chi2());
+  EXPECT_NE(r.out.find(chi2), std::string::npos) << chi2 << " not in\n" << r.out;
+  std::ofstream(dir / "bad.g2o") << "VERTEX_SE2 0 0 0 0\nEDGE_SE2 0 3 1 0 0 1 0 0 1 0 1\n";
+  expect_one_line_error("-d " + (dir / "bad.g2o").string(), {"bad.g2o:2: EDGE_SE2 names vertex 3"});
 }
 
 TEST_F(RunnerCli, TheDocsWorkedExampleFamilyRunsLikeAnyOther) {

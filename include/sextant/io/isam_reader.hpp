@@ -21,6 +21,7 @@
 #include "sextant/io/implausible_values.hpp"
 #include "sextant/io/input_file.hpp"
 #include "sextant/io/parse_number.hpp"
+#include "sextant/io/text_record.hpp"
 #include "sextant/models/point_in_robot_frame_2d.hpp"
 #include "sextant/models/se2_odometry.hpp"
 
@@ -93,38 +94,7 @@ Eigen::Matrix<double, N, N> noise_covariance(const std::vector<double>& values, 
   return cov;
 }
 
-/// One line of an iSAM file: its tag and values, and where it is for messages.
-struct IsamRecord {
-  std::string where, tag;
-  std::vector<double> values;
-
-  /// A value as an identifier; parse_error otherwise.
-  std::uint64_t identifier(std::size_t index, const char* what) const {
-    const auto id = as_identifier(values[index]);
-    if (!id)
-      throw parse_error(where + ": " + what + " must be a non-negative integer below 2^53, got " +
-                        std::to_string(values[index]));
-    return *id;
-  }
-  void require_fields(std::size_t count) const {
-    if (values.size() != count)
-      throw parse_error(where + ": " + tag + " needs " + std::to_string(count) + " values, found " +
-                        std::to_string(values.size()));
-  }
-};
-
-/// The record on `line`; nullopt for a blank line or a comment.
-inline std::optional<IsamRecord> parse_isam_record(const std::string& line, std::string where) {
-  std::istringstream fields(line);
-  IsamRecord record{std::move(where), {}, {}};
-  if (!(fields >> record.tag) || record.tag[0] == '#') return std::nullopt;
-  for (std::string word; fields >> word;) {
-    const auto value = parse_finite_number(word);
-    if (const auto error = data_number_error(word, value); !error.empty()) throw parse_error(record.where + ": " + error);
-    record.values.push_back(*value);
-  }
-  return record;
-}
+using IsamRecord = TextRecord;
 
 /// Builds the data set record by record (read_isam_2d).
 class IsamDatasetBuilder {
@@ -198,7 +168,7 @@ inline PlanarDataset read_isam_2d(const std::string& path, IsamNoise form) {
   detail::IsamDatasetBuilder builder(form);
   std::string line;
   for (int number = 1; std::getline(in, line); ++number)
-    if (const auto record = detail::parse_isam_record(line, path + ":" + std::to_string(number))) builder.add(*record);
+    if (const auto record = detail::parse_text_record(line, path + ":" + std::to_string(number))) builder.add(*record);
   if (builder.data().pose_ids.empty()) throw parse_error(path + ": no odometry or landmark records");
   return std::move(builder.data());
 }
