@@ -296,6 +296,18 @@ TEST(PoseGraph, BadEdgesAreRefusedAndLeaveTheGraphAsItWas) {
   EXPECT_EQ(graph.num_edges(), 0u);
 }
 
+/// An optimize() that throws (here: a start whose cost overflows) leaves the graph bit for bit as
+/// it was, the gauge included.
+TEST(PoseGraph, AFailedOptimizationLeavesTheGraphAsItWas) {
+  PoseGraph<PlanarPoses> graph;
+  graph.add_pose(0, Eigen::Vector3d::Zero());
+  graph.add_pose(1, Eigen::Vector3d(1e200, 0, 0));
+  graph.add_between(0, 1, Eigen::Vector3d(1, 0, 0), 1e200 * Eigen::Matrix3d::Identity());
+  EXPECT_THROW(graph.optimize(), numerical_error);
+  EXPECT_FALSE(graph.is_fixed(0));
+  EXPECT_EQ(graph.pose(1), Eigen::Vector3d(1e200, 0, 0));
+}
+
 // ----- files -----
 
 std::string write_temp(const std::string& name, const std::string& text) {

@@ -161,11 +161,12 @@ PoseGraphSummary PoseGraph<Poses>::optimize(const PoseGraphOptions& options) {
   if (options.max_iterations < 0) throw invalid_input_error("PoseGraphOptions: max_iterations must be >= 0");
   if (!(options.outlier_gate_probability >= 0.0 && options.outlier_gate_probability < 1.0))
     throw invalid_input_error("PoseGraphOptions: outlier_gate_probability must be in [0, 1)");
-  hold_gauge_if_free();
+  const std::vector<Vertex> vertices_before = vertices_;
   const std::vector<Pose> poses_before = poses_;
   const std::vector<Point> points_before = points_;
   const std::vector<Between> betweens_before = betweens_;
   try {
+    hold_gauge_if_free();
     for (auto& edge : betweens_) edge.rejected = false;
     PoseGraphSummary summary;
     summary.initial_chi2 = chi2();
@@ -179,7 +180,8 @@ PoseGraphSummary PoseGraph<Poses>::optimize(const PoseGraphOptions& options) {
     summary.final_chi2 = chi2();
     summary.seconds = std::chrono::duration<double>(Clock::now() - began).count();
     return summary;
-  } catch (...) {
+  } catch (...) {  // bit for bit as before, the gauge's hold included
+    vertices_ = vertices_before;
     poses_ = poses_before;
     points_ = points_before;
     betweens_ = betweens_before;
