@@ -11,28 +11,22 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
-#include <numbers>
 #include <vector>
 
 #include "sextant/backends/pose_graph.hpp"
+#include "support/ceres_problems.hpp"  // wrap: the angle wrap of the other Ceres peers
 
 namespace sextant::test {
-
-template <class T>
-T normalize_angle(const T& angle) {
-  const T two_pi = T(2.0 * std::numbers::pi);
-  return angle - two_pi * ceres::floor((angle + T(std::numbers::pi)) / two_pi);
-}
 
 struct AngleManifoldFunctor {
   template <class T>
   bool Plus(const T* x, const T* delta, T* out) const {
-    *out = normalize_angle(*x + *delta);
+    *out = wrap(*x + *delta);
     return true;
   }
   template <class T>
   bool Minus(const T* y, const T* x, T* out) const {
-    *out = normalize_angle(*y - *x);
+    *out = wrap(*y - *x);
     return true;
   }
 };
@@ -42,7 +36,7 @@ struct CeresPlanarEdge {
   bool operator()(const T* xa, const T* ya, const T* yaw_a, const T* xb, const T* yb, const T* yaw_b, T* r) const {
     const T c = ceres::cos(*yaw_a), s = ceres::sin(*yaw_a);
     const T dx = *xb - *xa, dy = *yb - *ya;
-    Eigen::Matrix<T, 3, 1> e(c * dx + s * dy - T(z(0)), -s * dx + c * dy - T(z(1)), normalize_angle(*yaw_b - *yaw_a - T(z(2))));
+    Eigen::Matrix<T, 3, 1> e(c * dx + s * dy - T(z(0)), -s * dx + c * dy - T(z(1)), wrap(*yaw_b - *yaw_a - T(z(2))));
     Eigen::Map<Eigen::Matrix<T, 3, 1>> residual(r);
     residual = sqrt_information.cast<T>() * e;
     return true;
@@ -119,7 +113,7 @@ inline CeresPoseGraphResult solve_with_ceres(PoseGraph<PlanarPoses>& graph) {
   problem.SetParameterBlockConstant(&yaw[0]);
   const auto result = solve_as_the_examples_do(problem, 100);
   for (std::size_t k = 0; k < n; ++k)
-    graph.set_pose(graph.pose_id(k), Eigen::Vector3d(x[k], y[k], normalize_angle(yaw[k])));
+    graph.set_pose(graph.pose_id(k), Eigen::Vector3d(x[k], y[k], wrap(yaw[k])));
   return result;
 }
 

@@ -142,8 +142,8 @@ class PoseGraph {
   const std::vector<Observation>& observations() const { return observations_; }
   const std::vector<Pose>& poses() const { return poses_; }
   const std::vector<Point>& points() const { return points_; }
-  VertexId pose_id(std::size_t slot) const { return pose_ids_[slot]; }
-  VertexId point_id(std::size_t slot) const { return point_ids_[slot]; }
+  VertexId pose_id(std::size_t slot) const { return vertices_[pose_vertex_[slot]].id; }
+  VertexId point_id(std::size_t slot) const { return vertices_[point_vertex_[slot]].id; }
 
  private:
   struct System;  // the sparse normal equations' layout and values (implementation)
@@ -153,7 +153,7 @@ class PoseGraph {
   void require_new_id(VertexId id) const;
   template <class Value>
   void add_vertex(VertexId id, bool finite, std::vector<Value>& values, const Value& initial,
-                  std::vector<std::size_t>& slot_vertex, std::vector<VertexId>& slot_id, bool is_point);
+                  std::vector<std::size_t>& slot_vertex, bool is_point);
   std::vector<Eigen::Index> variable_offsets(Eigen::Index& dimension) const;
   void hold_gauge_if_free();
   void initialize_points_from_first_observations();
@@ -177,7 +177,6 @@ class PoseGraph {
   std::unordered_map<VertexId, std::size_t> index_;
   std::vector<Pose> poses_;
   std::vector<Point> points_;
-  std::vector<VertexId> pose_ids_, point_ids_;
   std::vector<std::size_t> pose_vertex_, point_vertex_;  ///< slot -> vertex
   std::vector<Between> betweens_;
   std::vector<Prior> priors_;

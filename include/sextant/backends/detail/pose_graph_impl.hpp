@@ -54,19 +54,19 @@ std::size_t PoseGraph<Poses>::slot_of(VertexId id, bool is_point) const {
 
 template <class Poses>
 void PoseGraph<Poses>::add_pose(VertexId id, const Pose& initial) {
-  add_vertex(id, Poses::is_finite(initial), poses_, initial, pose_vertex_, pose_ids_, false);
+  add_vertex(id, Poses::is_finite(initial), poses_, initial, pose_vertex_, false);
 }
 
 template <class Poses>
 void PoseGraph<Poses>::add_point(VertexId id, const Point& initial) {
-  add_vertex(id, initial.allFinite(), points_, initial, point_vertex_, point_ids_, true);
+  add_vertex(id, initial.allFinite(), points_, initial, point_vertex_, true);
 }
 
-/// A new vertex at the end of `values` (poses or points), with its slot's vertex and id recorded.
+/// A new vertex at the end of `values` (poses or points), with its slot's vertex recorded.
 template <class Poses>
 template <class Value>
 void PoseGraph<Poses>::add_vertex(VertexId id, bool finite, std::vector<Value>& values, const Value& initial,
-                                  std::vector<std::size_t>& slot_vertex, std::vector<VertexId>& slot_id, bool is_point) {
+                                  std::vector<std::size_t>& slot_vertex, bool is_point) {
   require_new_id(id);
   if (!finite)
     throw invalid_input_error(std::string(is_point ? "point " : "pose ") + std::to_string(id) + " contains NaN or Inf");
@@ -74,7 +74,6 @@ void PoseGraph<Poses>::add_vertex(VertexId id, bool finite, std::vector<Value>& 
   slot_vertex.push_back(vertices_.size());
   vertices_.push_back({id, is_point, values.size(), false});
   values.push_back(initial);
-  slot_id.push_back(id);
 }
 
 template <class Poses>
