@@ -17,6 +17,7 @@
 #include "sextant/sim/globe_camera.hpp"
 #include "sextant/sim/ship_2d.hpp"
 #include "support/batch_least_squares.hpp"
+#include "support/seif_sparsification_reference.hpp"
 
 namespace sextant {
 namespace {
@@ -111,6 +112,31 @@ TEST(SeifSlam, SparsifiedFilterStaysCloseToTheExactFilter) {
     const auto exact = ekf.landmark(landmark.id);
     EXPECT_LT(eval::nees(landmark.mean - exact.mean, landmark.cov + exact.cov), test::nees_bound(2, map.size()))
         << landmark.id;
+  }
+}
+
+TEST(SeifSlam, SparsificationOnARecordedRunEqualsTheThesisForm) {
+  // The block the sparsification works on, taken from a filter on the ship run (no sparsification,
+  // so that many landmarks are linked to the robot): the rank-X form equals the thesis's two Schur
+  // complements within 1e-12 of the block's scale on the conditioning a real filter has.
+  const auto data = sim::simulate_ship_2d({.seed = 4, .num_steps = 60});
+  Seif seif{data.motion, data.sensor, data.prior, {.max_active = 0}};
+  eval::run(seif, data.steps);
+  const auto active = seif.active_landmarks();
+  ASSERT_GE(active.size(), 6u);
+  constexpr int X = 2, M = 2;  // the ship's position, a beacon's
+  static_assert(Seif::State::RowsAtCompileTime == X && Seif::Landmark::RowsAtCompileTime == M);
+  const Eigen::MatrixXd omega = seif.information_matrix();
+  std::vector<Eigen::Index> rows{0, 1};
+  for (const LandmarkId id : active) {
+    const auto slot = std::find(seif.landmark_ids().begin(), seif.landmark_ids().end(), id) - seif.landmark_ids().begin();
+    for (int k = 0; k < M; ++k) rows.push_back(X + M * slot + k);
+  }
+  const Eigen::MatrixXd D = omega(rows, rows);
+  for (const std::size_t kept : {std::size_t{1}, active.size() / 2, active.size() - 1}) {
+    const Eigen::MatrixXd expected = test::thesis_sparsification_change(D, X, M * kept);
+    const Eigen::MatrixXd change = test::sparsification_change_as_matrix<X>(D, M * kept);
+    EXPECT_LT((change - expected).cwiseAbs().maxCoeff(), 1e-12 * D.cwiseAbs().maxCoeff()) << kept << " kept";
   }
 }
 

@@ -172,12 +172,16 @@ class SeifSlam {
   void require_finite_robot_and_active(const char* what) const;
   void require_factorizable_robot_and_active(const char* what) const;
   void recover_mean_exactly_in_transaction();
-  void recover_mean_locally();
+  /// The squared pivots of the active block's factor when one was computed (active_block recovery).
+  std::optional<Eigen::VectorXd> recover_mean_locally();
   void recover_mean_by_coordinate_descent();
-  void recover_mean_of_active_block();
+  Eigen::VectorXd recover_mean_of_active_block();
   Eigen::MatrixXd robot_and_landmarks_block(const std::vector<std::size_t>& slots) const;
   void update_active_queue(const std::vector<std::size_t>& observed_slots);
-  void sparsify();
+  /// The squared pivots of the Cholesky factor of S_xx when it sparsified.
+  std::optional<Eigen::Matrix<double, X, 1>> sparsify();
+  void require_factorizable_after_update(const std::optional<Eigen::VectorXd>& squared_pivots,
+                                         const std::optional<Eigen::Matrix<double, X, 1>>& robot_squared_pivots) const;
   std::shared_ptr<const Factor> factorization() const;
   Eigen::MatrixXd marginal_covariance(Eigen::Index offset, Eigen::Index size) const;
   /// The joint covariance of the robot and the landmark blocks starting at `offsets`, in that order.

@@ -53,6 +53,20 @@ Eigen::LLT<typename Derived::PlainObject> cholesky_or_throw(const Eigen::MatrixB
 /// eigenvalue interlacing a principal block is never worse conditioned than the whole matrix,
 /// so failing this on a block proves the whole matrix numerically singular; passing it proves
 /// nothing, but nothing sound is cheaper (O(n^3 / 3) for the small blocks it is used on).
+/// The test of require_well_conditioned on the pivots d_i = L_ii^2 / a_ii of a Cholesky factor L of
+/// a (the pivots of a scaled to unit diagonal), for a caller that has factorized a already.
+inline void require_well_conditioned_pivots(const Eigen::VectorXd& pivots, const std::string& what) {
+  const double n = static_cast<double>(pivots.size());
+  const double bound = 20.0 * n * std::sqrt(n) * Eigen::NumTraits<double>::epsilon();
+  const double smallest_pivot = pivots.minCoeff();
+  if (!(smallest_pivot > bound)) {
+    char numbers[96];
+    std::snprintf(numbers, sizeof numbers, "its condition number is at least %.3g after scaling, above %.3g",
+                  1.0 / smallest_pivot, 1.0 / bound);
+    throw numerical_error(what + " is numerically singular (" + numbers + ")");
+  }
+}
+
 template <class Derived>
 void require_well_conditioned(const Eigen::MatrixBase<Derived>& a, const std::string& what) {
   using Plain = typename Derived::PlainObject;
@@ -63,15 +77,7 @@ void require_well_conditioned(const Eigen::MatrixBase<Derived>& a, const std::st
   const Plain scaled = scale.asDiagonal() * a * scale.asDiagonal();
   const Eigen::LLT<Plain> llt(scaled);
   if (llt.info() != Eigen::Success) throw numerical_error(what + " is not positive definite");
-  const double n = static_cast<double>(a.rows());
-  const double bound = 20.0 * n * std::sqrt(n) * Eigen::NumTraits<double>::epsilon();
-  const double smallest_pivot = llt.matrixLLT().diagonal().array().square().minCoeff();
-  if (!(smallest_pivot > bound)) {
-    char numbers[96];
-    std::snprintf(numbers, sizeof numbers, "its condition number is at least %.3g after scaling, above %.3g",
-                  1.0 / smallest_pivot, 1.0 / bound);
-    throw numerical_error(what + " is numerically singular (" + numbers + ")");
-  }
+  require_well_conditioned_pivots(llt.matrixLLT().diagonal().array().square().matrix(), what);
 }
 
 /// Squared Mahalanobis distance r^T A^-1 r given the Cholesky factor of A.

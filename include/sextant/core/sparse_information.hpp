@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "sextant/core/block_triplets.hpp"
+#include "sextant/core/dense_slot_map.hpp"
 #include "sextant/core/error.hpp"
 
 namespace sextant {
@@ -29,7 +30,7 @@ class SparseInformation {
   using LandmarkBlock = Eigen::Matrix<double, M, M>;
   using RobotVector = Eigen::Matrix<double, X, 1>;
   using LandmarkVector = Eigen::Matrix<double, M, 1>;
-  using Links = std::unordered_map<std::size_t, LandmarkBlock>;  ///< neighbour slot -> Omega_{i, j}
+  using Links = DenseSlotMap<LandmarkBlock>;  ///< neighbour slot -> Omega_{i, j}
 
   explicit SparseInformation(const RobotBlock& robot_information = RobotBlock::Identity())
       : robot_(robot_information), robot_residual_(RobotVector::Zero()) {}
@@ -74,9 +75,11 @@ class SparseInformation {
   const Links& links(std::size_t slot) const { return links_[slot]; }
   /// Omega_{i, j} += block and Omega_{j, i} += block^T, for i != j.
   void add_to_link(std::size_t i, std::size_t j, const LandmarkBlock& block) {
-    note_link(i, j);
-    note_link(j, i);
-    add_or_insert(links_[i], j, block);
+    if (i > j) return add_to_link(j, i, block.transpose());
+    auto [it, inserted] = links_[i].try_emplace(j, block);  // one look-up for the journal and the change
+    if (open_ && i < journal_.landmarks)
+      journal_.links.push_back({i, j, inserted ? std::nullopt : std::optional<LandmarkBlock>(it->second)});
+    if (!inserted) it->second += block;
     add_or_insert(links_[j], i, block.transpose());
   }
   /// Omega_{i, j} for any two slots (the diagonal block when i == j, zero when not linked).
@@ -122,15 +125,18 @@ class SparseInformation {
   /// Starts recording: until commit() or rollback(), every block changed through this interface
   /// keeps its old value. Landmarks may be appended; marginalize_landmark is not allowed.
   void begin_transaction() {
-    if (journal_) throw error("SparseInformation: a transaction is already open");
-    journal_.emplace(Journal{robot_, robot_residual_, num_landmarks(), {}, {}, {}});
+    if (open_) throw error("SparseInformation: a transaction is already open");
+    journal_.robot = robot_;
+    journal_.robot_residual = robot_residual_;
+    journal_.landmarks = num_landmarks();
+    open_ = true;
     ++transaction_;
   }
   /// Keeps every change since begin_transaction().
-  void commit() { journal_.reset(); }
+  void commit() { close_journal(); }
   /// Restores the form exactly as it was at begin_transaction().
   void rollback();
-  bool in_transaction() const { return journal_.has_value(); }
+  bool in_transaction() const { return open_; }
 
   /// Approximate heap bytes held (blocks and hash-map nodes), for memory reports.
   std::size_t memory_bytes() const;
@@ -145,21 +151,22 @@ class SparseInformation {
   /// In a transaction, keeps the old diagonal block and residual of a slot that existed when it
   /// began (once per transaction: saved_in_ holds the transaction that last saved each slot).
   void save(std::size_t slot) {
-    if (!journal_ || slot >= journal_->landmarks || saved_in_[slot] == transaction_) return;
+    if (!open_ || slot >= journal_.landmarks || saved_in_[slot] == transaction_) return;
     saved_in_[slot] = transaction_;
-    journal_->slots.push_back({slot, diagonal_[slot], landmark_residual_.template segment<M>(M * slot)});
+    journal_.slots.push_back({slot, diagonal_[slot], landmark_residual_.template segment<M>(M * slot)});
   }
   /// In a transaction, records Omega_{x, slot} (or its absence) before a change.
   void note_robot_link(std::size_t slot) {
-    if (!journal_) return;
+    if (!open_) return;
     const auto it = robot_links_.find(slot);
-    journal_->robot_links.push_back({slot, it == robot_links_.end() ? std::nullopt : std::optional(it->second)});
+    journal_.robot_links.push_back({slot, it == robot_links_.end() ? std::nullopt : std::optional(it->second)});
   }
-  /// In a transaction, records Omega_{i, j} (or its absence) before a change.
-  void note_link(std::size_t i, std::size_t j) {
-    if (!journal_ || i >= journal_->landmarks) return;
-    const auto it = links_[i].find(j);
-    journal_->links.push_back({i, j, it == links_[i].end() ? std::nullopt : std::optional(it->second)});
+  /// Ends the transaction; the journal keeps its capacity for the next one.
+  void close_journal() {
+    open_ = false;
+    journal_.slots.clear();
+    journal_.robot_links.clear();
+    journal_.links.clear();
   }
 
   struct SavedSlot {
@@ -190,16 +197,16 @@ class SparseInformation {
   std::vector<LandmarkBlock> diagonal_;
   std::vector<Links> links_;
   Eigen::VectorXd landmark_residual_;
-  std::optional<Journal> journal_;
+  Journal journal_;  ///< the open transaction's record (open_), kept allocated between transactions
+  bool open_ = false;
   std::vector<std::uint64_t> saved_in_;  ///< per slot, see save()
   std::uint64_t transaction_ = 0;
 };
 
 template <int X, int M>
 void SparseInformation<X, M>::rollback() {
-  if (!journal_) return;
-  Journal journal = std::move(*journal_);
-  journal_.reset();
+  if (!open_) return;
+  const Journal& journal = journal_;
   robot_ = journal.robot;
   robot_residual_ = journal.robot_residual;
   for (auto it = journal.robot_links.rbegin(); it != journal.robot_links.rend(); ++it) {  // newest first
@@ -208,11 +215,15 @@ void SparseInformation<X, M>::rollback() {
     else
       robot_links_.erase(it->slot);
   }
-  for (auto it = journal.links.rbegin(); it != journal.links.rend(); ++it) {
-    if (it->block)
-      links_[it->i][it->j] = *it->block;
-    else
+  for (auto it = journal.links.rbegin(); it != journal.links.rend(); ++it) {  // i < j, i existed
+    const bool j_existed = it->j < journal.landmarks;
+    if (it->block) {
+      links_[it->i].insert_or_assign(it->j, *it->block);
+      links_[it->j].insert_or_assign(it->i, it->block->transpose());
+    } else {
       links_[it->i].erase(it->j);
+      if (j_existed) links_[it->j].erase(it->i);
+    }
   }
   diagonal_.resize(journal.landmarks);
   links_.resize(journal.landmarks);
@@ -222,11 +233,12 @@ void SparseInformation<X, M>::rollback() {
     diagonal_[saved.slot] = saved.diagonal;
     landmark_residual_.template segment<M>(M * saved.slot) = saved.residual;
   }
+  close_journal();
 }
 
 template <int X, int M>
 void SparseInformation<X, M>::marginalize_landmark(std::size_t slot) {
-  if (journal_) throw error("SparseInformation: marginalize_landmark inside a transaction");
+  if (open_) throw error("SparseInformation: marginalize_landmark inside a transaction");
   const Eigen::LLT<LandmarkBlock> llt(diagonal_[slot]);
   if (llt.info() != Eigen::Success)
     throw numerical_error("information block of the landmark to marginalize is not positive definite");
@@ -266,12 +278,7 @@ void SparseInformation<X, M>::move_slot(std::size_t from, std::size_t to) {
   landmark_residual(to) = landmark_residual(from);
   links_[to] = std::move(links_[from]);
   links_[from].clear();
-  for (auto& [neighbour, block] : links_[to]) {
-    auto& back = links_[neighbour];
-    auto node = back.extract(from);
-    node.key() = to;
-    back.insert(std::move(node));
-  }
+  for (const auto& [neighbour, block] : links_[to]) links_[neighbour].rekey(from, to);
   if (auto node = robot_links_.extract(from); !node.empty()) {
     node.key() = to;
     robot_links_.insert(std::move(node));
@@ -299,8 +306,9 @@ std::size_t SparseInformation<X, M>::memory_bytes() const {
                       links_.capacity() * sizeof(Links) +
                       robot_links_.size() * (sizeof(CrossBlock) + node_overhead) +
                       robot_links_.bucket_count() * sizeof(void*);
-  for (const auto& links : links_)
-    bytes += links.size() * (sizeof(LandmarkBlock) + node_overhead) + links.bucket_count() * sizeof(void*);
+  for (const auto& links : links_) bytes += links.memory_bytes();
+  bytes += journal_.slots.capacity() * sizeof(SavedSlot) + journal_.robot_links.capacity() * sizeof(SavedRobotLink) +
+           journal_.links.capacity() * sizeof(SavedLink);
   return bytes;
 }
 

@@ -10,6 +10,7 @@
 
 #include "sextant/core/factor_information.hpp"
 #include "sextant/core/landmark_init.hpp"
+#include "sextant/core/seif_sparsification.hpp"
 #include "sextant/core/validation.hpp"
 
 namespace sextant {
@@ -168,15 +169,16 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
     times.measurement_s = seconds_since(stage_start);
     stage_start = Clock::now();
     ++updates_;
+    update_active_queue(observed);  // first: mean recovery orders the active block by it
+    std::optional<Eigen::VectorXd> squared_pivots;
     if (options_.exact_recovery_period > 0 && updates_ % static_cast<std::uint64_t>(options_.exact_recovery_period) == 0)
       recover_mean_exactly_in_transaction();
     else
-      recover_mean_locally();
+      squared_pivots = recover_mean_locally();
     times.mean_recovery_s = seconds_since(stage_start);
     stage_start = Clock::now();
-    update_active_queue(observed);
-    sparsify();
-    require_factorizable_robot_and_active("SEIF update");
+    const auto robot_squared_pivots = sparsify();
+    require_factorizable_after_update(squared_pivots, robot_squared_pivots);
     times.sparsification_s = seconds_since(stage_start);
   });
   last_update_times_ = times;
@@ -264,14 +266,35 @@ void SeifSlam<Motion, Sensor>::require_factorizable_robot_and_active(const char*
                            std::string(what) + ": the information of the robot and the active landmarks");
 }
 
+/// The update's check of the block it leaves (require_factorizable_robot_and_active) without a
+/// second factorization when mean recovery factorized the block before sparsification: with the
+/// robot first, the block after sparsification has the squared pivots of S_xx for the robot and
+/// those of the block before for m+ (core/seif_sparsification.hpp), scaled by its new diagonal.
 template <class Motion, class Sensor>
-void SeifSlam<Motion, Sensor>::recover_mean_locally() {
+void SeifSlam<Motion, Sensor>::require_factorizable_after_update(
+    const std::optional<Eigen::VectorXd>& squared_pivots,
+    const std::optional<Eigen::Matrix<double, X, 1>>& robot_squared_pivots) const {
+  constexpr const char* what = "SEIF update";
+  if (!squared_pivots) return require_factorizable_robot_and_active(what);
+  require_finite_robot_and_active(what);
+  Eigen::VectorXd pivots = squared_pivots->head(X + M * static_cast<Eigen::Index>(active_queue_.size()));
+  if (robot_squared_pivots) pivots.template head<X>() = *robot_squared_pivots;
+  pivots.template head<X>().array() /= info_.robot().diagonal().array();
+  for (std::size_t a = 0; a < active_queue_.size(); ++a)
+    pivots.template segment<M>(X + M * a).array() /= info_.diagonal(active_queue_[a]).diagonal().array();
+  require_well_conditioned_pivots(pivots, std::string(what) + ": the information of the robot and the active landmarks");
+}
+
+template <class Motion, class Sensor>
+std::optional<Eigen::VectorXd> SeifSlam<Motion, Sensor>::recover_mean_locally() {
+  std::optional<Eigen::VectorXd> squared_pivots;
   for (int sweep = 0; sweep < options_.mean_recovery_sweeps; ++sweep) {
     if (options_.mean_recovery == MeanRecovery::active_block)
-      recover_mean_of_active_block();
+      squared_pivots = recover_mean_of_active_block();
     else
       recover_mean_by_coordinate_descent();
   }
+  return squared_pivots;
 }
 
 /// Omega restricted to (robot, slots...) as a dense matrix.
@@ -284,23 +307,29 @@ Eigen::MatrixXd SeifSlam<Motion, Sensor>::robot_and_landmarks_block(const std::v
   for (std::size_t a = 0; a < slots.size(); ++a) {
     D.template block<X, M>(0, at(a)) = info_.robot_link(slots[a]);
     D.template block<M, X>(at(a), 0) = info_.robot_link(slots[a]).transpose();
-    for (std::size_t b = 0; b < slots.size(); ++b)
-      D.template block<M, M>(at(a), at(b)) = info_.landmark_block(slots[a], slots[b]);
+    D.template block<M, M>(at(a), at(a)) = info_.diagonal(slots[a]);
+    for (std::size_t b = a + 1; b < slots.size(); ++b) {  // one look-up per pair
+      const auto link = info_.links(slots[a]).find(slots[b]);
+      const bool linked = link != info_.links(slots[a]).end();
+      D.template block<M, M>(at(a), at(b)) = linked ? link->second : Eigen::Matrix<double, M, M>::Zero();
+      D.template block<M, M>(at(b), at(a)) = D.template block<M, M>(at(a), at(b)).transpose();
+    }
   }
   return D;
 }
 
-/// Solves Omega_BB delta_B = r_B for B = robot + active landmarks, moves their means, and passes
-/// the change on to the residuals of their passive neighbours: r_b -= Omega_bB delta_B.
+/// Solves Omega_BB delta_B = r_B for B = robot + active landmarks (in the queue's order), moves their
+/// means, and passes the change on to the residuals of their passive neighbours: r_b -= Omega_bB
+/// delta_B. Returns the squared diagonal of the Cholesky factor of Omega_BB.
 template <class Motion, class Sensor>
-void SeifSlam<Motion, Sensor>::recover_mean_of_active_block() {
-  std::vector<std::size_t> slots;
-  for (const auto& [slot, block] : info_.robot_links()) slots.push_back(slot);
+Eigen::VectorXd SeifSlam<Motion, Sensor>::recover_mean_of_active_block() {
+  const std::vector<std::size_t>& slots = active_queue_;
   const Eigen::MatrixXd D = robot_and_landmarks_block(slots);
   Eigen::VectorXd r(D.rows());
   r.template head<X>() = info_.robot_residual();
   for (std::size_t a = 0; a < slots.size(); ++a) r.template segment<M>(X + M * a) = info_.landmark_residual(slots[a]);
-  const Eigen::VectorXd delta = cholesky_or_throw(D, "information of the robot and the active landmarks").solve(r);
+  const auto llt = cholesky_or_throw(D, "information of the robot and the active landmarks");
+  const Eigen::VectorXd delta = llt.solve(r);
   const Eigen::VectorXd r_after = r - D * delta;
   x_ = Space::plus(x_, delta.template head<X>());
   info_.robot_residual() = r_after.template head<X>();
@@ -312,6 +341,7 @@ void SeifSlam<Motion, Sensor>::recover_mean_of_active_block() {
     for (const auto& [neighbour, block] : info_.links(slots[a]))
       if (!in_block.contains(neighbour)) info_.landmark_residual(neighbour) -= block.transpose() * dm;
   }
+  return llt.matrixLLT().diagonal().array().square().matrix();
 }
 
 /// Block coordinate descent on Omega delta = r over the robot and the active landmarks
@@ -371,61 +401,36 @@ void SeifSlam<Motion, Sensor>::update_active_queue(const std::vector<std::size_t
   active_queue_ = std::move(queue);
 }
 
-namespace detail {
-/// D with the variables at `eliminate` (block start, size) marginalized out: the Schur complement,
-/// written back into a matrix of the same size whose eliminated rows and columns are zero.
-inline Eigen::MatrixXd marginalize_dense(const Eigen::MatrixXd& D, const std::vector<Eigen::Index>& eliminate,
-                                         const std::string& what) {
-  const Eigen::Index n = D.rows();
-  std::vector<bool> gone(n, false);
-  for (Eigen::Index i : eliminate) gone[i] = true;
-  std::vector<Eigen::Index> keep;
-  for (Eigen::Index i = 0; i < n; ++i)
-    if (!gone[i]) keep.push_back(i);
-  const Eigen::MatrixXd D_kk = D(keep, keep), D_ke = D(keep, eliminate), D_ee = D(eliminate, eliminate);
-  const auto llt = cholesky_or_throw(D_ee, what);
-  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, n);
-  out(keep, keep) = D_kk - D_ke * llt.solve(D_ke.transpose());
-  return out;
-}
-}  // namespace detail
-
-/// Thesis eqs. (39)-(43), Appendix A: with B = (x, m+, m0) and D = Omega_BB,
-///   Omega~ - Omega = Omega1 - Omega2 - D_Bx D_xx^-1 D_xB on B,
-/// Omega1 = D with m0 marginalized, Omega2 = D with x and m0 marginalized. The residual r is
-/// unchanged: r~ = xi~ - Omega~ mu = xi + (Omega~ - Omega) mu - Omega~ mu = r (eq. 44).
+/// Thesis eqs. (37)-(44), Appendix A: the robot keeps its links to the first max_active landmarks of
+/// the queue (m+) and loses those to the rest (m0); the change of Omega on B = (x, m+, m0) is
+/// core/seif_sparsification.hpp's. The residual r is unchanged (eq. 44).
 template <class Motion, class Sensor>
-void SeifSlam<Motion, Sensor>::sparsify() {
-  if (options_.max_active == 0 || active_queue_.size() <= options_.max_active) return;
-  const std::vector<std::size_t>& block_slots = active_queue_;  // m+ = first max_active, m0 = the rest
+auto SeifSlam<Motion, Sensor>::sparsify() -> std::optional<Eigen::Matrix<double, X, 1>> {
+  if (options_.max_active == 0 || active_queue_.size() <= options_.max_active) return std::nullopt;
+  const std::vector<std::size_t>& R = active_queue_;
   const std::size_t kept = options_.max_active;
-  const Eigen::Index d = X + M * static_cast<Eigen::Index>(block_slots.size());
-  auto at = [](std::size_t k) { return X + M * static_cast<Eigen::Index>(k); };
-  const Eigen::MatrixXd D = robot_and_landmarks_block(block_slots);
-  std::vector<Eigen::Index> robot, dropped;
-  for (Eigen::Index i = 0; i < X; ++i) robot.push_back(i);
-  for (Eigen::Index i = at(kept); i < d; ++i) dropped.push_back(i);
-  std::vector<Eigen::Index> robot_and_dropped = robot;
-  robot_and_dropped.insert(robot_and_dropped.end(), dropped.begin(), dropped.end());
-  const Eigen::MatrixXd omega1 = detail::marginalize_dense(D, dropped, "information of the landmarks to deactivate");
-  const Eigen::MatrixXd omega2 =
-      detail::marginalize_dense(D, robot_and_dropped, "information of the robot and the landmarks to deactivate");
-  const auto robot_llt = cholesky_or_throw(info_.robot(), "robot block of the information matrix");
-  const Eigen::MatrixXd D_xB = D.topRows(X);
-  const Eigen::MatrixXd delta = omega1 - omega2 - D_xB.transpose() * robot_llt.solve(D_xB);
-
-  info_.robot() = symmetrized(info_.robot() + delta.template topLeftCorner<X, X>());
-  for (std::size_t a = 0; a < block_slots.size(); ++a) {
-    const std::size_t i = block_slots[a];
+  const Eigen::Index n_R = M * static_cast<Eigen::Index>(R.size());
+  const Eigen::Index n_dropped = n_R - M * static_cast<Eigen::Index>(kept);
+  Eigen::MatrixXd D_xR(X, n_R), D_0R(n_dropped, n_R);  // robot rows; rows of the landmarks to deactivate
+  for (std::size_t b = 0; b < R.size(); ++b) {
+    D_xR.template middleCols<M>(M * b) = info_.robot_link(R[b]);
+    for (std::size_t a = kept; a < R.size(); ++a)
+      D_0R.template block<M, M>(M * (a - kept), M * b) = info_.landmark_block(R[a], R[b]);
+  }
+  const auto change = seif_sparsification_change<X>(info_.robot(), D_xR, D_0R);
+  info_.robot() = symmetrized(info_.robot() + change.robot);
+  for (std::size_t a = 0; a < R.size(); ++a) {
+    const std::size_t i = R[a];
     if (a < kept)
-      info_.add_to_robot_link(i, delta.template block<X, M>(0, at(a)));
+      info_.add_to_robot_link(i, change.robot_kept.template middleCols<M>(M * a));
     else
       info_.remove_robot_link(i);
-    info_.diagonal(i) = symmetrized(info_.diagonal(i) + delta.template block<M, M>(at(a), at(a)));
-    for (std::size_t b = a + 1; b < block_slots.size(); ++b)
-      info_.add_to_link(i, block_slots[b], delta.template block<M, M>(at(a), at(b)));
+    info_.diagonal(i) = symmetrized(info_.diagonal(i) + change.landmarks.template block<M, M>(M * a, M * a));
+    for (std::size_t b = a + 1; b < R.size(); ++b)
+      info_.add_to_link(i, R[b], change.landmarks.template block<M, M>(M * a, M * b));
   }
   active_queue_.resize(kept);
+  return change.robot_squared_pivots;
 }
 
 template <class Motion, class Sensor>
