@@ -87,6 +87,46 @@ TEST_P(FastVersions, AfterResamplingEachParticlesUpdateDependsOnlyOnItsOwnMap) {
       EXPECT_EQ(fast.particles()[i].landmarks[j].mean, before[i].landmarks[j].mean);
 }
 
+TEST_P(FastVersions, BeforeTheFirstLandmarkTheParticlesDeadReckonTogetherAndThePoseCarriesTheSpread) {
+  // Before any landmark, sampled particles would differ only by where each later puts the map: a
+  // rigid motion no measurement can see, that resampling then freezes into the map of one ancestor.
+  // The particles dead-reckon together instead, and pose() is the dead-reckoned Gaussian (the
+  // EKF's, the peer here), whose spread stays as the uncertainty of the map's frame.
+  const auto data = sim::simulate_ship_2d({.seed = 6, .num_steps = 20});
+  Fast fast{data.motion, data.sensor, data.prior, {.particles = 30, .version = GetParam()}};
+  EkfSlam<BeaconShip2D, BeaconOffset2D> ekf{data.motion, data.sensor, data.prior};
+  for (int k = 0; k < 3; ++k) {
+    fast.predict(data.steps[k].control, data.steps[k].dt);
+    ekf.predict(data.steps[k].control, data.steps[k].dt);
+    for (const auto& particle : fast.particles()) EXPECT_EQ(particle.x, fast.particles().front().x);
+    EXPECT_LT((fast.pose().mean - ekf.pose().mean).norm(), 1e-9);
+    EXPECT_LT((fast.pose().cov - ekf.pose().cov).norm(), 1e-9 * ekf.pose().cov.norm());
+  }
+  const Eigen::Matrix2d frame = ekf.pose().cov;
+  ASSERT_FALSE(data.steps[3].observations.empty());
+  fast.update(data.steps[3].observations);
+  for (const auto& landmark : fast.map())  // mapped from the common pose: equal in every particle, plus the frame
+    EXPECT_LT((landmark.cov - (data.sensor.noise() + frame)).norm(), 1e-9 * frame.norm()) << landmark.id;
+}
+
+TEST(FastSlam, VersionTwoReportsTheMixtureOfItsProposalsNotItsDraws) {
+  // FastSLAM 2.0's weight does not depend on the pose drawn from the proposal (eq. 93), so the
+  // mixture of the proposals is the Rao-Blackwellized estimate of the pose: with one particle,
+  // the proposal's mean and covariance (plus the frame's), never the draw with zero spread.
+  const auto data = sim::simulate_ship_2d({.seed = 7, .num_steps = 30});
+  Fast fast{data.motion, data.sensor, data.prior, {.particles = 1, .version = FastSlamVersion::v2}};
+  for (std::size_t k = 0; k < data.steps.size(); ++k) {
+    fast.predict(data.steps[k].control, data.steps[k].dt);
+    fast.update(data.steps[k].observations);
+  }
+  const auto& particle = fast.particles().front();
+  const auto pose = fast.pose();
+  EXPECT_EQ(pose.mean, particle.drawn_from);
+  EXPECT_NE(pose.mean, particle.x);
+  EXPECT_GT(particle.drawn_cov.determinant(), 0.0);
+  EXPECT_GT((pose.cov - particle.drawn_cov).determinant(), 0.0);  // the frame's uncertainty
+}
+
 INSTANTIATE_TEST_SUITE_P(BothVersions, FastVersions, ::testing::Values(FastSlamVersion::v1, FastSlamVersion::v2));
 
 TEST(FastSlam, TracksTheShipAndVersionTwoBeatsVersionOne) {

@@ -82,6 +82,17 @@ class FastSlam {
     Map<LandmarkGaussian<M>> landmarks;  ///< indexed by the filter's landmark index (known ids)
     Map<LandmarkGaussian<M>> unassociated;  ///< landmarks this particle found by its own association
     double log_weight = 0.0;
+    /// The Gaussian x was drawn from where the particle's weight does not depend on the draw (the
+    /// prior, FastSLAM 2.0's proposal, eqs. 82-93): pose() averages these instead of the draws
+    /// (Rao-Blackwellized). Where the weight does depend on it (FastSLAM 1.0), x itself with zero
+    /// covariance.
+    State drawn_from;
+    Eigen::Matrix<double, X, X> drawn_cov = Eigen::Matrix<double, X, X>::Zero();
+    /// x is a point from here on: its weight is about to depend on the draw.
+    void forget_proposal() {
+      drawn_from = x;
+      drawn_cov.setZero();
+    }
   };
 
   FastSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, FastSlamOptions options = {});
@@ -100,9 +111,11 @@ class FastSlam {
 
   void remove_landmark(LandmarkId id);
 
-  /// Weighted mean and covariance of the particle cloud (tangent space around the best particle),
-  /// taken after the last update and before its resampling, which would duplicate particles and
-  /// shrink the spread; after a predict, the current cloud.
+  /// The weighted mixture of the particles' pose Gaussians (tangent space around the best particle):
+  /// FastSLAM 2.0's proposals after an update (Particle::drawn_from), each particle's motion
+  /// prediction after a predict, and FastSLAM 1.0's points; the covariance is the mixture's (within
+  /// plus between particles). Taken after the last update and before its resampling, which would
+  /// duplicate particles and shrink the spread.
   PoseEstimate pose() const;
   MapEstimate map() const;
   LandmarkEstimate<M> landmark(LandmarkId id) const;
@@ -131,8 +144,17 @@ class FastSlam {
     std::vector<PendingMotion> pending;
     LandmarkId next_unassociated_id;
     bool resampled = false;
+    Eigen::Matrix<double, X, X> frame_cov;
+    bool frame_fixed;
   };
-  Transaction begin() const { return {particles_, rng_, estimate_, pending_, next_unassociated_id_, false}; }
+  Transaction begin() const {
+    return {particles_, rng_, estimate_, pending_, next_unassociated_id_, false, frame_cov_, frame_fixed_};
+  }
+  /// Before the first landmark the particles would differ only by where they put the map (a rigid
+  /// motion no later measurement can see): they move together at the dead-reckoned mean, and the
+  /// spread they would have had is kept as frame_cov_, the uncertainty of the map's frame.
+  void predict_without_map(const Control& u, double dt);
+  void fix_frame_if_mapped(Transaction& t) const;
   void commit(Transaction&& t);
 
   static State sample(const State& mean, const Eigen::Matrix<double, X, X>& cov, std::mt19937_64& rng);
@@ -173,6 +195,7 @@ class FastSlam {
                                                  std::span<const Measurement> measurements, bool proposal) const;
   void normalize_and_resample(Transaction& t) const;
   PoseEstimate cloud_estimate(const std::vector<Particle>& cloud, const std::vector<PendingMotion>& pending) const;
+  PoseEstimate pose_component(const Particle& particle, const std::vector<PendingMotion>& pending) const;
   static std::vector<double> normalized_weights(const std::vector<Particle>& particles);
   static double effective_sample_size_of(const std::vector<double>& normalized);
   bool is_current(std::size_t index) const {
@@ -182,6 +205,12 @@ class FastSlam {
   static std::size_t best_particle(const std::vector<Particle>& particles);
   std::size_t best_particle() const { return best_particle(particles_); }
   std::optional<LandmarkEstimate<M>> unassociated_landmark(LandmarkId id) const;
+  /// A landmark covariance in the particles' frame plus the frame's uncertainty (its translation:
+  /// the leading M entries of the state, as the runner's scoring assumes).
+  Eigen::Matrix<double, M, M> in_world_frame(const Eigen::Matrix<double, M, M>& cov) const {
+    static_assert(X >= M, "FastSlam: the pose must hold the landmark's position first");
+    return cov + frame_cov_.template topLeftCorner<M, M>();
+  }
 
   Motion motion_;
   Sensor sensor_;
@@ -195,6 +224,11 @@ class FastSlam {
   std::mt19937_64 rng_;
   std::size_t resamplings_ = 0;
   std::optional<PoseEstimate> estimate_;  ///< the weighted cloud of the last update, before resampling
+  /// Uncertainty of the frame the particles map in, relative to the prior's: the prior and the motion
+  /// before the first landmark (dead reckoning, not sampled); frozen from the first landmark on and
+  /// added to the reported covariances (without the lever arm of its rotation part).
+  Eigen::Matrix<double, X, X> frame_cov_;
+  bool frame_fixed_ = false;  ///< a landmark has been mapped
 };
 
 }  // namespace sextant

@@ -39,7 +39,8 @@ FastSlam<Motion, Sensor, Map>::FastSlam(Motion motion, Sensor sensor, const Pose
     throw invalid_input_error("FastSlamOptions: new_landmark_nis must be positive and finite (0: the default)");
   gate_ = InnovationGate(Z, options_.gate_probability);
   particles_.resize(options_.particles);
-  for (auto& particle : particles_) particle.x = sample(prior.mean, prior.cov, rng_);
+  for (auto& particle : particles_) particle.x = particle.drawn_from = prior.mean;  // see predict_without_map
+  frame_cov_ = prior.cov;
 }
 
 /// x = plus(mean, L n), n ~ N(0, I), with cov = L L^T from an LDL^T factorization (semi-definite
@@ -66,6 +67,30 @@ void FastSlam<Motion, Sensor, Map>::commit(Transaction&& t) {
   pending_ = std::move(t.pending);
   next_unassociated_id_ = t.next_unassociated_id;
   if (t.resampled) ++resamplings_;
+  frame_cov_ = t.frame_cov;
+  frame_fixed_ = t.frame_fixed;
+}
+
+/// Dead reckoning of the common pose and of the frame's covariance: Sigma <- G Sigma G^T + R.
+template <class Motion, class Sensor, template <class> class Map>
+void FastSlam<Motion, Sensor, Map>::predict_without_map(const Control& u, double dt) {
+  Transaction t = begin();
+  const auto p = checked_motion_prediction(motion_, t.particles.front().x, u, dt);
+  t.frame_cov = symmetrized(p.J_x_x * t.frame_cov * p.J_x_x.transpose() + p.R);
+  if (!t.frame_cov.allFinite()) throw numerical_error("FastSLAM dead-reckoned frame covariance is not finite");
+  for (auto& particle : t.particles) {
+    particle.x = p.x;
+    particle.forget_proposal();
+  }
+  t.estimate = PoseEstimate{p.x, t.frame_cov};
+  commit(std::move(t));
+}
+
+/// The frame is fixed by the first landmark any particle maps.
+template <class Motion, class Sensor, template <class> class Map>
+void FastSlam<Motion, Sensor, Map>::fix_frame_if_mapped(Transaction& t) const {
+  for (const auto& particle : t.particles)
+    if (particle.landmarks.size() > 0 || particle.unassociated.size() > 0) t.frame_fixed = true;
 }
 
 /// FastSLAM 1.0 samples now; 2.0 keeps the motion pending for update()'s proposal (a second predict
@@ -75,6 +100,7 @@ template <class Motion, class Sensor, template <class> class Map>
 void FastSlam<Motion, Sensor, Map>::predict(const Control& u, double dt) {
   require_finite(u, "control");
   require_positive_time_step(dt);
+  if (!frame_fixed_) return predict_without_map(u, dt);
   Transaction t = begin();
   t.estimate.reset();
   apply_pending_motion_v1(t);
@@ -94,6 +120,7 @@ void FastSlam<Motion, Sensor, Map>::apply_pending_motion_v1(Transaction& t) cons
     for (auto& particle : t.particles) {
       const auto p = checked_motion_prediction(motion_, particle.x, motion.u, motion.dt);
       particle.x = sample(p.x, p.R, t.rng);
+      particle.forget_proposal();
     }
   t.pending.clear();
 }
@@ -195,6 +222,8 @@ auto FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const
   }
   if (!std::isfinite(particle.log_weight)) throw numerical_error("FastSLAM 2.0 proposal weight is not finite");
   particle.x = sample(mean, cov, rng);
+  particle.drawn_from = mean;
+  particle.drawn_cov = cov;
   return outcomes;
 }
 
@@ -205,6 +234,7 @@ auto FastSlam<Motion, Sensor, Map>::update_known_landmarks(Particle& particle, s
                                                            bool proposal, Transaction& t) const -> std::vector<Outcome> {
   std::vector<Outcome> outcomes;
   if (!proposal) {
+    particle.forget_proposal();
     for (const auto& observation : known) {
       const auto result = update_landmark(particle, index_.at(observation.landmark_id), observation.z, false, true);
       particle.log_weight += result.log_likelihood;
@@ -245,6 +275,7 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
   }
   result.corrected = known.size() - result.rejected.size() - known_unusable;
   result.initialized = added.size();
+  fix_frame_if_mapped(t);
   normalize_and_resample(t);
   auto index = index_;
   auto id_of_index = id_of_index_;
@@ -304,6 +335,7 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
   t.pending.clear();
   t.next_unassociated_id += measurements.size();
   const std::size_t initialized = started[best_particle(t.particles)];
+  fix_frame_if_mapped(t);
   normalize_and_resample(t);
   commit(std::move(t));
   return {measurements.size() - initialized, initialized, {}, {}};
@@ -374,32 +406,44 @@ std::size_t FastSlam<Motion, Sensor, Map>::best_particle(const std::vector<Parti
                                   particles.begin());
 }
 
-/// Weighted mean and covariance of the poses, in the tangent space at the best particle (a pose
-/// not yet sampled by FastSLAM 2.0 counts at its predicted mean).
+/// The weighted mixture of the particles' pose Gaussians, in the tangent space at the best particle.
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::pose() const -> PoseEstimate {
   return estimate_ ? *estimate_ : cloud_estimate(particles_, pending_);
+}
+
+/// One particle's pose Gaussian: after a predict of FastSLAM 2.0 (pending motions), its draw carried
+/// through them, N(g(x, u), G Sigma G^T + R); otherwise the Gaussian it was drawn from.
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::pose_component(const Particle& particle, const std::vector<PendingMotion>& pending) const
+    -> PoseEstimate {
+  if (pending.empty()) return {particle.drawn_from, particle.drawn_cov};
+  PoseEstimate out{particle.x, PoseMatrix::Zero()};
+  for (const auto& motion : pending) {
+    const auto p = motion_.predict(out.mean, motion.u, motion.dt);
+    out = {p.x, symmetrized(p.J_x_x * out.cov * p.J_x_x.transpose() + p.R)};
+  }
+  return out;
 }
 
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::cloud_estimate(const std::vector<Particle>& cloud,
                                                    const std::vector<PendingMotion>& pending) const -> PoseEstimate {
   const auto w = normalized_weights(cloud);
-  auto pose_of = [&](const Particle& p) {
-    State x = p.x;
-    for (const auto& motion : pending) x = motion_.predict(x, motion.u, motion.dt).x;
-    return x;
-  };
-  const State reference = pose_of(cloud[best_particle(cloud)]);
+  std::vector<PoseEstimate> components;
+  components.reserve(cloud.size());
+  for (const auto& particle : cloud) components.push_back(pose_component(particle, pending));
+  const State reference = components[best_particle(cloud)].mean;
   Eigen::Matrix<double, X, 1> mean_d = Eigen::Matrix<double, X, 1>::Zero();
   std::vector<Eigen::Matrix<double, X, 1>> d;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    d.push_back(Space::minus(pose_of(cloud[i]), reference));
+    d.push_back(Space::minus(components[i].mean, reference));
     mean_d += w[i] * d.back();
   }
   Eigen::Matrix<double, X, X> cov = Eigen::Matrix<double, X, X>::Zero();
-  for (std::size_t i = 0; i < cloud.size(); ++i) cov += w[i] * (d[i] - mean_d) * (d[i] - mean_d).transpose();
-  PoseEstimate out{Space::plus(reference, mean_d), symmetrized(cov)};
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    cov += w[i] * (components[i].cov + (d[i] - mean_d) * (d[i] - mean_d).transpose());
+  PoseEstimate out{Space::plus(reference, mean_d), symmetrized(cov + frame_cov_)};
   if (!Space::is_finite(out.mean) || !out.cov.allFinite()) throw numerical_error("FastSLAM cloud pose estimate is not finite");
   return out;
 }
@@ -409,7 +453,7 @@ template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::unassociated_landmark(LandmarkId id) const -> std::optional<LandmarkEstimate<M>> {
   const auto& map = particles_[best_particle()].unassociated;
   for (std::size_t j = 0; j < map.size(); ++j)
-    if (map[j].alive && map[j].id == id) return LandmarkEstimate<M>{id, map[j].mean, map[j].cov};
+    if (map[j].alive && map[j].id == id) return LandmarkEstimate<M>{id, map[j].mean, in_world_frame(map[j].cov)};
   return std::nullopt;
 }
 
@@ -422,7 +466,7 @@ auto FastSlam<Motion, Sensor, Map>::landmark(LandmarkId id) const -> LandmarkEst
   }
   if (options_.map_estimate == FastSlamMap::best_particle) {
     const auto& L = particles_[best_particle()].landmarks[it->second];
-    return {id, L.mean, L.cov};
+    return {id, L.mean, in_world_frame(L.cov)};
   }
   const auto w = weights();
   Eigen::Matrix<double, M, 1> mean = Eigen::Matrix<double, M, 1>::Zero();
@@ -432,7 +476,7 @@ auto FastSlam<Motion, Sensor, Map>::landmark(LandmarkId id) const -> LandmarkEst
     const auto& L = particles_[i].landmarks[it->second];
     cov += w[i] * (L.cov + (L.mean - mean) * (L.mean - mean).transpose());
   }
-  return {id, mean, symmetrized(cov)};
+  return {id, mean, in_world_frame(symmetrized(cov))};
 }
 
 /// The known landmarks (per options().map_estimate), then those the most likely particle created
@@ -444,7 +488,7 @@ auto FastSlam<Motion, Sensor, Map>::map() const -> MapEstimate {
     if (is_current(index)) out.push_back(landmark(id_of_index_[index]));
   const auto& own = particles_[best_particle()].unassociated;
   for (std::size_t j = 0; j < own.size(); ++j)
-    if (own[j].alive) out.push_back({own[j].id, own[j].mean, own[j].cov});
+    if (own[j].alive) out.push_back({own[j].id, own[j].mean, in_world_frame(own[j].cov)});
   return out;
 }
 
@@ -536,6 +580,9 @@ std::size_t FastSlam<Motion, Sensor, Map>::update_particle_unassociated(Particle
   }
   const auto match = associate_in_particle(particle, mean, cov, measurements, proposal);
   particle.x = proposal ? sample(mean, cov, t.rng) : mean;
+  particle.drawn_from = particle.x;
+  particle.drawn_cov = cov;  // zero without the proposal
+  if (proposal) particle.drawn_from = mean;
   std::size_t started = 0;
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     if (match[i] != kNewLandmark) {
