@@ -227,6 +227,20 @@ class WrittenRawlog : public ::testing::Test {
   }
 };
 
+TEST_F(WrittenRawlog, GroundTruthIsFoundUnderTheDemosAndUnderSimulLandmarksNames) {
+  const auto touch = [](const std::filesystem::path& file) { std::ofstream(file) << "0 0 0\n"; };
+  const auto log = (dir / "run.rawlog").string();
+  EXPECT_FALSE(find_ground_truth(log));
+  touch(dir / "run.rawlog_ground_truth.txt");  // simul-landmarks writes <name>.rawlog_ground_truth*.txt
+  EXPECT_FALSE(find_ground_truth(log)) << "a map without a path is not ground truth";
+  touch(dir / "run.rawlog_ground_truth_robot_path.txt");
+  ASSERT_TRUE(find_ground_truth(log));
+  EXPECT_EQ(find_ground_truth(log)->path, log + "_ground_truth_robot_path.txt");
+  touch(dir / "run_ground_truth.txt");  // the demos' <stem>_ground_truth*.txt come first
+  touch(dir / "run_ground_truth_robot_path.txt");
+  EXPECT_EQ(find_ground_truth(log)->map, (dir / "run_ground_truth.txt").string());
+}
+
 TEST_F(WrittenRawlog, ActionFrameLogBecomesStepsAndSkipsTheLeadingFrame) {
   const auto first = action(0.5, 0.0, 0.1);
   const auto path = write("log.rawlog", false, frame(bearing({{1, 2.0f}})), first,

@@ -15,8 +15,9 @@ namespace {
 mrpt_io::GroundTruthFiles require_ground_truth(const std::string& path) {
   const auto truth = mrpt_io::find_ground_truth(path);
   if (!truth)
-    throw parse_error(path + ": no ground truth beside it (<name>_ground_truth.txt and "
-                             "<name>_ground_truth_robot_path.txt); sextant-run scores against ground truth");
+    throw parse_error(path + ": no ground truth beside it (<stem>_ground_truth.txt and "
+                             "<stem>_ground_truth_robot_path.txt, or simul-landmarks' <name>.rawlog_ground_truth.txt "
+                             "and <name>.rawlog_ground_truth_robot_path.txt); sextant-run scores against ground truth");
   return *truth;
 }
 

@@ -376,16 +376,19 @@ inline std::variant<RawlogDataset2D, RawlogDataset3D> read_rawlog(const std::str
   return detail::to_planar(path, raw, parser.sensor(), detail::ids_of(parser), options);
 }
 
-/// The ground-truth files MRPT ships beside a demo rawlog: `<stem>_ground_truth.txt` (map) and
-/// `<stem>_ground_truth_robot_path.txt` (path), if both exist.
+/// The ground-truth files beside a rawlog, if both exist: `<stem>_ground_truth.txt` (map) and
+/// `<stem>_ground_truth_robot_path.txt` (path) as MRPT's demo logs ship them, or
+/// `<name>.rawlog_ground_truth.txt` and `<name>.rawlog_ground_truth_robot_path.txt` as MRPT's
+/// simul-landmarks writes them.
 struct GroundTruthFiles {
   std::string map, path;
 };
 inline std::optional<GroundTruthFiles> find_ground_truth(const std::string& rawlog_path) {
   const std::filesystem::path p(rawlog_path);
-  const auto stem = (p.parent_path() / p.stem()).string();
-  GroundTruthFiles files{stem + "_ground_truth.txt", stem + "_ground_truth_robot_path.txt"};
-  if (std::filesystem::exists(files.map) && std::filesystem::exists(files.path)) return files;
+  for (const auto& stem : {(p.parent_path() / p.stem()).string(), rawlog_path}) {
+    GroundTruthFiles files{stem + "_ground_truth.txt", stem + "_ground_truth_robot_path.txt"};
+    if (std::filesystem::exists(files.map) && std::filesystem::exists(files.path)) return files;
+  }
   return std::nullopt;
 }
 
