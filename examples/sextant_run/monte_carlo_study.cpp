@@ -17,12 +17,25 @@ std::vector<std::pair<std::string, double>> association_extras(const Association
           {"association_discarded", static_cast<double>(a.discarded)}};
 }
 
+std::vector<std::pair<std::string, double>> cloud_extras(const CloudRow& cloud) {
+  return {{"cloud_particles", cloud.particles},
+          {"cloud_effective_sample_size", cloud.effective_sample_size},
+          {"cloud_distinct_ancestors", cloud.distinct_ancestors}};
+}
+
 namespace {
 
+bool has_extra(const eval::StudyRecord& r, const char* name) {
+  return std::any_of(r.extras.begin(), r.extras.end(), [&](const auto& e) { return e.first == name; });
+}
+
+std::optional<CloudRow> cloud_of(const eval::StudyRecord& r) {
+  if (!has_extra(r, "cloud_particles")) return std::nullopt;
+  return CloudRow{r.extra("cloud_particles"), r.extra("cloud_effective_sample_size"), r.extra("cloud_distinct_ancestors")};
+}
+
 std::optional<AssociationRow> association_of(const eval::StudyRecord& r) {
-  const auto has = [&](const char* name) {
-    return std::any_of(r.extras.begin(), r.extras.end(), [&](const auto& e) { return e.first == name; });
-  };
+  const auto has = [&](const char* name) { return has_extra(r, name); };
   if (!has("association_precision")) return std::nullopt;
   return AssociationRow{r.extra("association_precision"), r.extra("association_recall"), static_cast<std::size_t>(r.extra("association_wrong")),
                         static_cast<std::size_t>(r.extra("association_duplicates")),
@@ -31,7 +44,7 @@ std::optional<AssociationRow> association_of(const eval::StudyRecord& r) {
 
 /// The row of one cell's runs (records[begin, end), in seed order).
 TableRow row_of(std::vector<eval::StudyRecord>::const_iterator begin, std::vector<eval::StudyRecord>::const_iterator end) {
-  TableRow row{begin->dataset, begin->cell, begin->label, {}, static_cast<int>(end - begin), std::nullopt, std::nullopt};
+  TableRow row{begin->dataset, begin->cell, begin->label, {}, static_cast<int>(end - begin), std::nullopt, std::nullopt, std::nullopt};
   std::vector<eval::RunScores> scores;
   for (auto r = begin; r != end; ++r) {
     if (!r->failure.empty() && !row.failure) row.failure = "seed " + std::to_string(r->seed) + ": " + r->failure;
@@ -43,6 +56,7 @@ TableRow row_of(std::vector<eval::StudyRecord>::const_iterator begin, std::vecto
   }
   row.summary = eval::summarize(scores, begin->pose_dof);
   row.association = association_of(*begin);  // the first seed's
+  row.cloud = cloud_of(*begin);
   return row;
 }
 

@@ -16,6 +16,8 @@ std::vector<TableRow> rows_of(const std::vector<eval::StudyRecord>& records);
 
 /// The association's numbers as a record's extras.
 std::vector<std::pair<std::string, double>> association_extras(const AssociationRow& a);
+/// A FastSLAM run's cloud at its end as a record's extras (read back by the table's row).
+std::vector<std::pair<std::string, double>> cloud_extras(const CloudRow& cloud);
 
 /// --merge: prints the table of the study whose record files (or directories of them) are `paths`
 /// and returns its rows.

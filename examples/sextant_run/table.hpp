@@ -71,6 +71,9 @@ inline void print_row(const TableRow& row) {
   if (const auto& a = row.association)
     std::printf("%-29s association: precision %.4f, recall %.4f; %zu wrong pairings, %zu duplicate landmarks, %zu "
                 "discarded\n", "", a->precision, a->recall, a->wrong, a->duplicates, a->discarded);
+  if (const auto& cloud = row.cloud)
+    std::printf("%-29s the cloud at the end: N_eff %.3g of %.0f; all descend from %.0f of the %.0f it started with\n", "",
+                cloud->effective_sample_size, cloud->particles, cloud->distinct_ancestors, cloud->particles);
   print_skipped_steps(29, row.summary.failed_steps, "step", row.summary.first_failure);  // over all its runs
 }
 

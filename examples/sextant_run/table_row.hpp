@@ -51,6 +51,11 @@ struct AssociationRow {
   std::size_t wrong, duplicates, discarded;
 };
 
+/// A particle filter's cloud at the end of a run (FastSLAM): what its NEES columns rest on.
+struct CloudRow {
+  double particles, effective_sample_size, distinct_ancestors;
+};
+
 /// A line of the comparison table.
 struct TableRow {
   std::string dataset, backend, label;
@@ -58,6 +63,7 @@ struct TableRow {
   int runs = 1;
   std::optional<AssociationRow> association;
   std::optional<std::string> failure;  ///< why the back-end gave no result: its row prints this instead
+  std::optional<CloudRow> cloud;       ///< FastSLAM: the first run's cloud at its end
 };
 
 }  // namespace sextant::runner

@@ -109,6 +109,27 @@ TEST_P(FastVersions, BeforeTheFirstLandmarkTheParticlesDeadReckonTogetherAndTheP
     EXPECT_LT((landmark.cov - (data.sensor.noise() + frame)).norm(), 1e-9 * frame.norm()) << landmark.id;
 }
 
+TEST(FastSlam, CountsTheAncestorsTheCloudStillDescendsFrom) {
+  // Without resampling every particle keeps its own line; resampling copies lines and drops others,
+  // so the count can only fall, and on the ship's 200 steps it falls (the path degeneracy).
+  const auto data = sim::simulate_ship_2d({.seed = 3, .num_steps = 200});
+  Fast never{data.motion, data.sensor, data.prior, {.particles = 40, .resample_threshold = 0.0}};
+  Fast always{data.motion, data.sensor, data.prior, {.particles = 40, .resample_threshold = 1.0}};
+  EXPECT_EQ(always.distinct_ancestors(), 40u);
+  std::size_t previous = 40;
+  for (const auto& step : data.steps) {
+    never.predict(step.control, step.dt);
+    never.update(step.observations);
+    always.predict(step.control, step.dt);
+    always.update(step.observations);
+    EXPECT_LE(always.distinct_ancestors(), previous);
+    previous = always.distinct_ancestors();
+  }
+  EXPECT_EQ(never.distinct_ancestors(), 40u);
+  EXPECT_LT(always.distinct_ancestors(), 40u);
+  EXPECT_GE(always.distinct_ancestors(), 1u);
+}
+
 TEST(FastSlam, VersionTwoReportsTheMixtureOfItsProposalsNotItsDraws) {
   // FastSLAM 2.0's weight does not depend on the pose drawn from the proposal (eq. 93), so the
   // mixture of the proposals is the Rao-Blackwellized estimate of the pose: with one particle,

@@ -88,6 +88,7 @@ class FastSlam {
     /// covariance.
     State drawn_from;
     Eigen::Matrix<double, X, X> drawn_cov = Eigen::Matrix<double, X, X>::Zero();
+    std::size_t ancestor = 0;  ///< which of the first step's particles this one descends from
     /// x is a point from here on: its weight is about to depend on the draw.
     void forget_proposal() {
       drawn_from = x;
@@ -127,6 +128,9 @@ class FastSlam {
   std::vector<double> weights() const;
   /// Effective sample size 1 / sum w^2 of the normalized weights.
   double effective_sample_size() const;
+  /// How many of the first step's particles the cloud descends from: 1 means every path shares one
+  /// ancestor (the path degeneracy that makes FastSLAM inconsistent over long runs).
+  std::size_t distinct_ancestors() const;
   std::size_t resamplings() const { return resamplings_; }
   const FastSlamOptions& options() const { return options_; }
 

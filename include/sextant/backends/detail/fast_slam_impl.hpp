@@ -39,7 +39,10 @@ FastSlam<Motion, Sensor, Map>::FastSlam(Motion motion, Sensor sensor, const Pose
     throw invalid_input_error("FastSlamOptions: new_landmark_nis must be positive and finite (0: the default)");
   gate_ = InnovationGate(Z, options_.gate_probability);
   particles_.resize(options_.particles);
-  for (auto& particle : particles_) particle.x = particle.drawn_from = prior.mean;  // see predict_without_map
+  for (std::size_t n = 0; n < particles_.size(); ++n) {
+    particles_[n].x = particles_[n].drawn_from = prior.mean;  // see predict_without_map
+    particles_[n].ancestor = n;
+  }
   frame_cov_ = prior.cov;
 }
 
@@ -389,6 +392,14 @@ std::vector<double> FastSlam<Motion, Sensor, Map>::weights() const {
 template <class Motion, class Sensor, template <class> class Map>
 double FastSlam<Motion, Sensor, Map>::effective_sample_size() const {
   return effective_sample_size_of(weights());
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+std::size_t FastSlam<Motion, Sensor, Map>::distinct_ancestors() const {
+  std::vector<std::size_t> ancestors;
+  for (const auto& particle : particles_) ancestors.push_back(particle.ancestor);
+  std::sort(ancestors.begin(), ancestors.end());
+  return static_cast<std::size_t>(std::unique(ancestors.begin(), ancestors.end()) - ancestors.begin());
 }
 
 /// N_eff = 1 / sum w_i^2 of normalized weights (§3.7.4).
