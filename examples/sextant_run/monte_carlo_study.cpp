@@ -35,8 +35,7 @@ std::optional<CloudRow> cloud_of(const eval::StudyRecord& r) {
 }
 
 std::optional<AssociationRow> association_of(const eval::StudyRecord& r) {
-  const auto has = [&](const char* name) { return has_extra(r, name); };
-  if (!has("association_precision")) return std::nullopt;
+  if (!has_extra(r, "association_precision")) return std::nullopt;
   return AssociationRow{r.extra("association_precision"), r.extra("association_recall"), static_cast<std::size_t>(r.extra("association_wrong")),
                         static_cast<std::size_t>(r.extra("association_duplicates")),
                         static_cast<std::size_t>(r.extra("association_discarded"))};
