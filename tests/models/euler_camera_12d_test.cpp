@@ -63,6 +63,33 @@ TEST(EulerCamera12D, MeasurementAndInverseJacobiansMatchCentralDifferences) {
     }
 }
 
+/// The camera claiming psi as well (a wrong claim the check must see).
+struct ClaimingPsi : EulerCamera12D {
+  static constexpr int kConditionallyLinearDims = 7;
+};
+
+TEST(EulerCamera12D, VelocityAndRateAreAConditionallyLinearTailNoMeasurementSees) {
+  static_assert(conditionally_linear_dims_v<EulerCamera12D> == 6);
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  EulerCamera12D model;
+  model.gamma << 0.9, 0.95, 1.0;
+  model.lambda << 0.8, 1.0, 0.7;
+  PointInCamera3D sensor;
+  for (double phi : {0.0, 0.4, -1.2})
+    for (int trial = 0; trial < 10; ++trial) {
+      const Vector12d x = random_state(rng, phi);
+      const Eigen::Vector3d in_camera(0.3 * u(rng), 0.3 * u(rng), 0.5 + 0.5 * std::abs(u(rng)));
+      const Eigen::Vector3d m = x.head<3>() + euler_yxz::rotation(x.segment<3>(3)) * in_camera;
+      const auto check = testing::check_conditionally_linear_tail(model, sensor, x, {}, 0.05, m, 0.05);
+      EXPECT_TRUE(check) << "phi " << phi << "\n" << check.report;
+    }
+  // The check sees a wrong claim: psi, the 7th entry from the end, turns the position's step R v dt.
+  const Vector12d x = random_state(rng, 0.4);
+  const Eigen::Vector3d m = x.head<3>() + euler_yxz::rotation(x.segment<3>(3)) * Eigen::Vector3d(0.1, 0.0, 0.6);
+  EXPECT_FALSE(testing::check_conditionally_linear_tail(ClaimingPsi{}, sensor, x, {}, 0.05, m, 0.05));
+}
+
 TEST(EulerCamera12D, MotionThrowsAtTheGimbalSingularity) {
   Vector12d x = Vector12d::Zero();
   x(3) = kPi / 2;

@@ -14,6 +14,7 @@
 #include "sextant/core/landmark_pool.hpp"
 #include "sextant/core/chi_square.hpp"
 #include "sextant/core/concepts.hpp"
+#include "sextant/core/conditionally_linear.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/innovation_gate.hpp"
 #include "sextant/core/persistent_array.hpp"
@@ -30,6 +31,14 @@ enum class FastSlamVersion {
 enum class FastSlamMap {
   best_particle,     ///< the particle with the largest weight
   weighted_average,  ///< per landmark, the moment-matched mixture over all particles
+};
+
+/// What a particle does with the trailing state entries its motion model declares conditionally linear
+/// (core/conditionally_linear.hpp; e.g. the 12D camera's velocity and angular rate). Models without
+/// such entries behave the same either way.
+enum class FastSlamLinearTail {
+  sampled,  ///< sampled with the rest of the state, as FastSLAM does (the default: steadier at 100 particles)
+  kalman,   ///< kept as a Kalman filter given the particle's sampled path (a marginalized particle filter)
 };
 
 struct FastSlamOptions {
@@ -52,6 +61,8 @@ struct FastSlamOptions {
   /// weighs as a measurement on the gate's edge, like a new landmark. UpdateResult::rejected lists
   /// the observations the most likely particle rejected. 0 = off.
   double gate_probability = 0.0;
+  /// docs/results/globe.md measures both on the 12D camera.
+  FastSlamLinearTail linear_tail = FastSlamLinearTail::sampled;
 };
 
 /// One landmark of one particle: an EKF over its position (eqs. 75-78).
@@ -77,22 +88,30 @@ class FastSlam {
  public:
   SEXTANT_BACKEND_TYPES;
 
+  /// Trailing state entries the motion model declares conditionally linear (core/conditionally_linear.hpp):
+  /// with FastSlamLinearTail::kalman each particle keeps them as a Kalman filter given its sampled
+  /// path instead of sampling them.
+  static constexpr int T = conditionally_linear_dims_v<Motion>;
+
   struct Particle {
-    State x;
+    State x;  ///< the sampled entries, and the tail's mean given them
+    /// Covariance of the conditionally linear tail given the sampled entries (zero outside it; all
+    /// zero for a model without a tail).
+    Eigen::Matrix<double, X, X> cov = Eigen::Matrix<double, X, X>::Zero();
     Map<LandmarkGaussian<M>> landmarks;  ///< indexed by the filter's landmark index (known ids)
     Map<LandmarkGaussian<M>> unassociated;  ///< landmarks this particle found by its own association
     double log_weight = 0.0;
     /// The Gaussian x was drawn from where the particle's weight does not depend on the draw (the
     /// prior, FastSLAM 2.0's proposal, eqs. 82-93): pose() averages these instead of the draws
-    /// (Rao-Blackwellized). Where the weight does depend on it (FastSLAM 1.0), x itself with zero
-    /// covariance.
+    /// (Rao-Blackwellized). Where the weight does depend on it (FastSLAM 1.0), x itself with the
+    /// tail's covariance.
     State drawn_from;
     Eigen::Matrix<double, X, X> drawn_cov = Eigen::Matrix<double, X, X>::Zero();
     std::size_t ancestor = 0;  ///< which of the first step's particles this one descends from
     /// x is a point from here on: its weight is about to depend on the draw.
     void forget_proposal() {
       drawn_from = x;
-      drawn_cov.setZero();
+      drawn_cov = cov;
     }
   };
 
@@ -161,7 +180,13 @@ class FastSlam {
   void fix_frame_if_mapped(Transaction& t) const;
   void commit(Transaction&& t);
 
-  static State sample(const State& mean, const Eigen::Matrix<double, X, X>& cov, std::mt19937_64& rng);
+  /// The particle after a draw from N(mean, cov): its sampled entries drawn, its tail kept Gaussian.
+  void draw_into(Particle& particle, const PoseEstimate& gaussian, std::mt19937_64& rng) const;
+  bool keeps_tail() const { return T > 0 && options_.linear_tail == FastSlamLinearTail::kalman; }
+  /// Cov(tail | rest) of a Gaussian over the state where the particles keep a tail, else zero.
+  Eigen::Matrix<double, X, X> kept_tail(const Eigen::Matrix<double, X, X>& cov) const;
+  /// N(g(x, u), G C G^T + R) for a particle at x whose tail has covariance C (checked prediction).
+  PoseEstimate motion_gaussian(const State& x, const Eigen::Matrix<double, X, X>& cov, const Control& u, double dt) const;
   void apply_pending_motion_v1(Transaction& t) const;
   /// What became of one observation in one particle.
   enum class Outcome : char { used, gated, unusable };
@@ -189,7 +214,7 @@ class FastSlam {
   ProposalInnovation proposal_innovation(Prediction prediction, const PoseMatrix& cov, const LandmarkGaussian<M>& landmark,
                                          const Measurement& z) const;
   static double fold_into_proposal(State& mean, PoseMatrix& cov, const ProposalInnovation& innovation);
-  std::vector<Outcome> sample_v2_proposal(Particle& particle, const State& predicted, const PoseMatrix& R,
+  std::vector<Outcome> sample_v2_proposal(Particle& particle, const PoseEstimate& prior,
                                           std::span<const ObservationType> known, std::mt19937_64& rng) const;
   std::vector<Outcome> update_known_landmarks(Particle& particle, std::span<const ObservationType> known,
                                               bool proposal, Transaction& t) const;

@@ -149,6 +149,10 @@ struct EulerCamera12D {
   using Control = Eigen::Matrix<double, 0, 1>;  ///< no control: the camera is handheld
   using Space = EulerCamera12Space;
   static constexpr int kDim = 12;
+  /// v and omega enter g linearly once p and eta are fixed, R depends on eta alone, and the point
+  /// measurement does not see them: FastSLAM keeps them as a Kalman filter per particle
+  /// (core/conditionally_linear.hpp).
+  static constexpr int kConditionallyLinearDims = 6;
 
   Eigen::Vector3d gamma = Eigen::Vector3d::Ones();   ///< diagonal of Gamma, in (0, 1]
   Eigen::Vector3d lambda = Eigen::Vector3d::Ones();  ///< diagonal of Lambda, in (0, 1]

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "sextant/core/concepts.hpp"
+#include "sextant/core/conditionally_linear.hpp"
 
 namespace sextant::testing {
 
@@ -144,6 +145,36 @@ CheckResult check_measurement_jacobians(const Sensor& sensor, const typename Mot
   const auto round_trip = sensor.residual(Measurement(sensor.predict(x, init.m).z), z);
   detail::compare("inverse model: residual(predict(x, initialize(x, z)), z)", round_trip,
                   Eigen::Matrix<double, Z, 1>::Zero(), options, result);
+  return result;
+}
+
+/// Checks what a motion model promises with kConditionallyLinearDims = T (core/conditionally_linear.hpp)
+/// at (x, u, dt) with a landmark m: moving the tail by d moves g by exactly G d (a step of 1 and of
+/// 10 times `tail_step` in each direction, so curvature shows), R does not change, and the
+/// measurement neither changes nor has a Jacobian there.
+template <class Motion, class Sensor>
+  requires MeasurementModelFor<Sensor, Motion>
+CheckResult check_conditionally_linear_tail(const Motion& model, const Sensor& sensor, const typename Motion::State& x,
+                                            const typename Motion::Control& u, double dt,
+                                            const typename Sensor::Landmark& m, double tail_step = 0.1,
+                                            CheckOptions options = {.step = 0.0, .tolerance = 1e-10}) {
+  using Space = typename Motion::Space;
+  constexpr int X = Motion::kDim, T = conditionally_linear_dims_v<Motion>;
+  CheckResult result;
+  const auto at_x = model.predict(x, u, dt);
+  const auto z = sensor.predict(x, m);
+  detail::compare("J_z_x on the tail", z.J_z_x.template rightCols<T>(),
+                  Eigen::Matrix<double, measurement_dim_v<Sensor>, T>::Zero(), options, result);
+  for (int i = 0; i < T; ++i)
+    for (double scale : {1.0, -10.0}) {
+      Eigen::Matrix<double, X, 1> d = Eigen::Matrix<double, X, 1>::Zero();
+      d(X - T + i) = scale * tail_step;
+      const auto moved = model.predict(Space::plus(x, d), u, dt);
+      const std::string where = " (tail entry " + std::to_string(i) + ", step " + std::to_string(d(X - T + i)) + ")";
+      detail::compare("g" + where, Space::minus(moved.x, at_x.x), (at_x.J_x_x * d).eval(), options, result);
+      detail::compare("R" + where, moved.R, at_x.R, options, result);
+      detail::compare("z" + where, sensor.predict(Space::plus(x, d), m).z, z.z, options, result);
+    }
   return result;
 }
 

@@ -39,26 +39,41 @@ FastSlam<Motion, Sensor, Map>::FastSlam(Motion motion, Sensor sensor, const Pose
     throw invalid_input_error("FastSlamOptions: new_landmark_nis must be positive and finite (0: the default)");
   gate_ = InnovationGate(Z, options_.gate_probability);
   particles_.resize(options_.particles);
+  const PoseMatrix tail = kept_tail(prior.cov);
   for (std::size_t n = 0; n < particles_.size(); ++n) {
-    particles_[n].x = particles_[n].drawn_from = prior.mean;  // see predict_without_map
+    particles_[n].x = prior.mean;  // see predict_without_map
+    particles_[n].cov = tail;
+    particles_[n].forget_proposal();
     particles_[n].ancestor = n;
   }
-  frame_cov_ = prior.cov;
+  frame_cov_ = prior.cov - tail;
 }
 
-/// x = plus(mean, L n), n ~ N(0, I), with cov = L L^T from an LDL^T factorization (semi-definite
-/// allowed; callers have checked that cov is positive semi-definite up to rounding).
+/// The sampled entries from the Gaussian, the tail at its conditional mean with its conditional
+/// covariance (core/conditionally_linear.hpp; without a tail a plain draw, callers having checked
+/// that the covariance is positive semi-definite up to rounding).
 template <class Motion, class Sensor, template <class> class Map>
-auto FastSlam<Motion, Sensor, Map>::sample(const State& mean, const Eigen::Matrix<double, X, X>& cov,
-                                           std::mt19937_64& rng) -> State {
-  const Eigen::LDLT<Eigen::Matrix<double, X, X>> ldlt(cov);
-  std::normal_distribution<double> unit(0.0, 1.0);
-  Eigen::Matrix<double, X, 1> n;
-  for (int i = 0; i < X; ++i) n(i) = unit(rng) * std::sqrt(std::max(ldlt.vectorD()(i), 0.0));
-  const Eigen::Matrix<double, X, 1> d = ldlt.transpositionsP().transpose() * (ldlt.matrixL() * n);
-  const State x = Space::plus(mean, d);
-  if (!Space::is_finite(x)) throw numerical_error("sampled particle pose is not finite");
-  return x;
+void FastSlam<Motion, Sensor, Map>::draw_into(Particle& particle, const PoseEstimate& gaussian,
+                                              std::mt19937_64& rng) const {
+  auto draw = keeps_tail() ? draw_lead_keep_tail<Space, T>(gaussian.mean, gaussian.cov, rng)
+                           : draw_lead_keep_tail<Space, 0>(gaussian.mean, gaussian.cov, rng);
+  particle.x = std::move(draw.x);
+  particle.cov = std::move(draw.cov);
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::kept_tail(const PoseMatrix& cov) const -> PoseMatrix {
+  return keeps_tail() ? conditional_tail_covariance<T>(cov) : PoseMatrix::Zero().eval();
+}
+
+/// The motion of a particle whose tail is Gaussian: exact, since g is linear in the tail once the
+/// sampled entries are fixed and R does not depend on it (Schoen et al. 2005, eqs. 9-10).
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::motion_gaussian(const State& x, const PoseMatrix& cov, const Control& u,
+                                                    double dt) const -> PoseEstimate {
+  auto p = checked_motion_prediction(motion_, x, u, dt);
+  if (!keeps_tail()) return {std::move(p.x), std::move(p.R)};  // cov is zero
+  return {std::move(p.x), symmetrized((p.J_x_x * cov * p.J_x_x.transpose() + p.R).eval())};
 }
 
 
@@ -74,18 +89,23 @@ void FastSlam<Motion, Sensor, Map>::commit(Transaction&& t) {
   frame_fixed_ = t.frame_fixed;
 }
 
-/// Dead reckoning of the common pose and of the frame's covariance: Sigma <- G Sigma G^T + R.
+/// Dead reckoning of the common pose and of its covariance, Sigma <- G Sigma G^T + R, split into the
+/// frame's part and the particles' conditionally linear tail (which stays theirs: no rigid motion).
 template <class Motion, class Sensor, template <class> class Map>
 void FastSlam<Motion, Sensor, Map>::predict_without_map(const Control& u, double dt) {
   Transaction t = begin();
-  const auto p = checked_motion_prediction(motion_, t.particles.front().x, u, dt);
-  t.frame_cov = symmetrized(p.J_x_x * t.frame_cov * p.J_x_x.transpose() + p.R);
-  if (!t.frame_cov.allFinite()) throw numerical_error("FastSLAM dead-reckoned frame covariance is not finite");
+  const Particle& common = t.particles.front();
+  const auto p = checked_motion_prediction(motion_, common.x, u, dt);
+  const PoseMatrix total = symmetrized(p.J_x_x * (t.frame_cov + common.cov) * p.J_x_x.transpose() + p.R);
+  if (!total.allFinite()) throw numerical_error("FastSLAM dead-reckoned frame covariance is not finite");
+  const PoseMatrix tail = kept_tail(total);
+  t.frame_cov = total - tail;
   for (auto& particle : t.particles) {
     particle.x = p.x;
+    particle.cov = tail;
     particle.forget_proposal();
   }
-  t.estimate = PoseEstimate{p.x, t.frame_cov};
+  t.estimate = PoseEstimate{p.x, total};
   commit(std::move(t));
 }
 
@@ -116,13 +136,13 @@ void FastSlam<Motion, Sensor, Map>::predict(const Control& u, double dt) {
   commit(std::move(t));
 }
 
-/// FastSLAM 1.0 (eq. 74): every particle samples x ~ N(g(x, u), R) for each pending motion.
+/// FastSLAM 1.0 (eq. 74): every particle samples x ~ N(g(x, u), R) for each pending motion (its
+/// sampled entries; the tail given them).
 template <class Motion, class Sensor, template <class> class Map>
 void FastSlam<Motion, Sensor, Map>::apply_pending_motion_v1(Transaction& t) const {
   for (const auto& motion : t.pending)
     for (auto& particle : t.particles) {
-      const auto p = checked_motion_prediction(motion_, particle.x, motion.u, motion.dt);
-      particle.x = sample(p.x, p.R, t.rng);
+      draw_into(particle, motion_gaussian(particle.x, particle.cov, motion.u, motion.dt), t.rng);
       particle.forget_proposal();
     }
   t.pending.clear();
@@ -202,11 +222,11 @@ double FastSlam<Motion, Sensor, Map>::fold_into_proposal(State& mean, PoseMatrix
 }
 
 template <class Motion, class Sensor, template <class> class Map>
-auto FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const State& predicted, const PoseMatrix& R,
+auto FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const PoseEstimate& prior,
                                                        std::span<const ObservationType> known,
                                                        std::mt19937_64& rng) const -> std::vector<Outcome> {
-  State mean = predicted;
-  PoseMatrix cov = R;
+  State mean = prior.mean;
+  PoseMatrix cov = prior.cov;
   std::vector<Outcome> outcomes(known.size(), Outcome::used);
   for (std::size_t i = 0; i < known.size(); ++i) {
     const LandmarkGaussian<M>& L = particle.landmarks[index_.at(known[i].landmark_id)];
@@ -224,7 +244,7 @@ auto FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const
     particle.log_weight += fold_into_proposal(mean, cov, innovation);
   }
   if (!std::isfinite(particle.log_weight)) throw numerical_error("FastSLAM 2.0 proposal weight is not finite");
-  particle.x = sample(mean, cov, rng);
+  draw_into(particle, {mean, cov}, rng);
   particle.drawn_from = mean;
   particle.drawn_cov = cov;
   return outcomes;
@@ -245,8 +265,8 @@ auto FastSlam<Motion, Sensor, Map>::update_known_landmarks(Particle& particle, s
     }
     return outcomes;
   }
-  const auto p = checked_motion_prediction(motion_, particle.x, t.pending.back().u, t.pending.back().dt);
-  outcomes = sample_v2_proposal(particle, p.x, p.R, known, t.rng);
+  const auto& motion = t.pending.back();
+  outcomes = sample_v2_proposal(particle, motion_gaussian(particle.x, particle.cov, motion.u, motion.dt), known, t.rng);
   for (std::size_t i = 0; i < known.size(); ++i)
     if (outcomes[i] == Outcome::used &&
         update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false, false).outcome == Outcome::unusable)
@@ -429,7 +449,7 @@ template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::pose_component(const Particle& particle, const std::vector<PendingMotion>& pending) const
     -> PoseEstimate {
   if (pending.empty()) return {particle.drawn_from, particle.drawn_cov};
-  PoseEstimate out{particle.x, PoseMatrix::Zero()};
+  PoseEstimate out{particle.x, particle.cov};
   for (const auto& motion : pending) {
     const auto p = motion_.predict(out.mean, motion.u, motion.dt);
     out = {p.x, symmetrized(p.J_x_x * out.cov * p.J_x_x.transpose() + p.R)};
@@ -582,18 +602,19 @@ template <class Motion, class Sensor, template <class> class Map>
 std::size_t FastSlam<Motion, Sensor, Map>::update_particle_unassociated(Particle& particle,
                                                                         std::span<const Measurement> measurements,
                                                                         bool proposal, Transaction& t) const {
-  State mean = particle.x;
-  PoseMatrix cov = PoseMatrix::Zero();
-  for (const auto& motion : t.pending) {
-    const auto p = checked_motion_prediction(motion_, mean, motion.u, motion.dt);
-    mean = proposal ? p.x : sample(p.x, p.R, t.rng);
-    if (proposal) cov = p.R;
-  }
+  // Only FastSLAM 2.0 leaves motion pending (1.0 samples it in predict), so the prior is the
+  // particle's point (tail Gaussian) without the proposal.
+  PoseEstimate prior{particle.x, particle.cov};
+  for (const auto& motion : t.pending) prior = motion_gaussian(prior.mean, prior.cov, motion.u, motion.dt);
+  auto [mean, cov] = prior;
   const auto match = associate_in_particle(particle, mean, cov, measurements, proposal);
-  particle.x = proposal ? sample(mean, cov, t.rng) : mean;
-  particle.drawn_from = particle.x;
-  particle.drawn_cov = cov;  // zero without the proposal
-  if (proposal) particle.drawn_from = mean;
+  if (proposal) {
+    draw_into(particle, {mean, cov}, t.rng);
+    particle.drawn_from = mean;
+    particle.drawn_cov = cov;
+  } else {
+    particle.forget_proposal();
+  }
   std::size_t started = 0;
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     if (match[i] != kNewLandmark) {
