@@ -45,6 +45,15 @@ bool use_observability_constraints(AutoSwitch choice) {
   return choice == AutoSwitch::on;
 }
 
+/// The mean SEIF reports (RunnerConfig::seif_estimate): `auto` (nullopt) means the exact mean with
+/// relocalization, whose information form discards but never invents information, and the recovered
+/// mean with the thesis's sparsification, whose exact mean is what its approximation corrupts
+/// (docs/results/seif_relocalization.md).
+inline SeifEstimate use_estimate(const std::optional<SeifEstimate>& choice, SeifSparsification sparsification) {
+  if (choice) return *choice;
+  return sparsification == SeifSparsification::relocalization ? SeifEstimate::exact_mean : SeifEstimate::recovered_mean;
+}
+
 /// One choice per kind, as the config sets it: the first-estimate policy for Motion's chart and
 /// FastSLAM's version from the kind.
 template <class Motion>
@@ -56,6 +65,9 @@ std::vector<BackendChoice> backend_choices(const std::vector<BackendKind>& kinds
     choice.seif.first_estimate_jacobians = use_first_estimates<Motion>(c.seif_first_estimates);
     choice.ekf.observability_constraints = use_observability_constraints<Motion>(c.ekf_observability_constraints);
     choice.seif.observability_constraints = use_observability_constraints<Motion>(c.seif_observability_constraints);
+    choice.seif.estimate = use_estimate(c.seif_estimate, choice.seif.sparsification);
+    if (kind == BackendKind::seif && choice.seif.sparsification == SeifSparsification::relocalization)
+      choice.label = "E" + choice.label;  // ESEIF-SLAM, Walter, Eustice and Leonard's exactly sparse filter
     choice.fastslam.version = kind == BackendKind::fastslam1 ? FastSlamVersion::v1 : FastSlamVersion::v2;
     choices.push_back(std::move(choice));
   }

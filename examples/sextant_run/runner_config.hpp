@@ -93,6 +93,7 @@ struct RunnerConfig {
   AutoSwitch ekf_observability_constraints = AutoSwitch::automatic;
   AutoSwitch seif_observability_constraints = AutoSwitch::automatic;
   SeifOptions seif{.max_active = 8};
+  std::optional<SeifEstimate> seif_estimate;              ///< nullopt: auto (backend_factory.hpp)
   GraphOptions graph;
   PoseGraphOptions pose_graph;
   PoseGraphStart pose_graph_start = PoseGraphStart::file;
@@ -357,6 +358,26 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.seif.gate_probability = parse_gate_probability(v); }},
       {"seif", "max_active", "8", "landmarks kept linked to the robot by sparsification; 0 = no sparsification",
        [](RunnerConfig& c, const std::string& v) { c.seif.max_active = parse_integer<std::size_t>(v, 0, 1e6); }},
+      {"seif", "sparsification", "thesis",
+       "thesis (eqs. 37-44: drops the links, overconfident) | relocalization (ESEIF: marginalizes the robot and "
+       "relocalizes it from held-back measurements, conservative; needs measurements that determine the robot "
+       "state, so not the globe or VI-SLAM; docs/results/seif_relocalization.md)",
+       [](RunnerConfig& c, const std::string& v) {
+         c.seif.sparsification = parse_choice<SeifSparsification>(
+             v, {{"thesis", SeifSparsification::thesis}, {"relocalization", SeifSparsification::relocalization}});
+       }},
+      {"seif", "estimate", "auto",
+       "auto (exact_mean with relocalization, recovered_mean with the thesis's sparsification) | recovered_mean (the "
+       "update's, passive landmarks as they left the active set) | exact_mean (Omega^-1 xi, one more solve per query)",
+       [](RunnerConfig& c, const std::string& v) {
+         c.seif_estimate = v == "auto" ? std::nullopt
+                                       : std::optional(parse_choice<SeifEstimate>(
+                                             v, {{"recovered_mean", SeifEstimate::recovered_mean},
+                                                 {"exact_mean", SeifEstimate::exact_mean}}));
+       }},
+      {"seif", "relocalization_min_information", "0.05",
+       "relocalization: share of the robot's information the held-back measurements must carry in every direction",
+       [](RunnerConfig& c, const std::string& v) { c.seif.relocalization_min_information = non_negative(parse_number(v), v); }},
       {"seif", "mean_recovery", "active_block", "active_block (joint solve) | coordinate_descent (thesis)",
        [](RunnerConfig& c, const std::string& v) {
          c.seif.mean_recovery = parse_choice<MeanRecovery>(
@@ -424,6 +445,13 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) {
          c.fastslam.map_estimate =
              parse_choice<FastSlamMap>(v, {{"best_particle", FastSlamMap::best_particle}, {"weighted_average", FastSlamMap::weighted_average}});
+       }},
+      {"fastslam", "linear_tail", "sampled",
+       "sampled | kalman: what particles do with state entries the motion model declares conditionally linear "
+       "(the globe camera's velocity and rate): sample them, or keep a Kalman filter over them per particle",
+       [](RunnerConfig& c, const std::string& v) {
+         c.fastslam.linear_tail = parse_choice<FastSlamLinearTail>(
+             v, {{"sampled", FastSlamLinearTail::sampled}, {"kalman", FastSlamLinearTail::kalman}});
        }},
       {"fastslam", "seed", "1", "random seed",
        [](RunnerConfig& c, const std::string& v) { c.fastslam.seed = parse_integer<std::uint64_t>(v, 0); }},

@@ -96,6 +96,7 @@ std::vector<double> fingerprint(const Backend& backend) {
   if constexpr (requires { backend.particles(); }) {
     for (const auto& particle : backend.particles()) {
       put(particle.x);
+      put(particle.cov);
       out.push_back(particle.log_weight);
       for (std::size_t j = 0; j < particle.landmarks.size(); ++j) {
         put(particle.landmarks[j].mean);
@@ -132,6 +133,13 @@ struct EkfJoseph {
 struct SeifSparsified {
   static auto make() {
     return SeifSlam<FaultyMotion, FaultySensor>{FaultyMotion{}, FaultySensor{}, test::kLinearPrior, {.max_active = 3}};
+  }
+};
+struct SeifRelocalization {
+  static auto make() {
+    return SeifSlam<FaultyMotion, FaultySensor>{
+        FaultyMotion{}, FaultySensor{}, test::kLinearPrior,
+        {.max_active = 2, .sparsification = SeifSparsification::relocalization, .estimate = SeifEstimate::exact_mean}};
   }
 };
 struct SeifCoordinateDescent {
@@ -211,7 +219,7 @@ class StrongGuarantee : public ::testing::Test {
   long faults_ = 0;
 };
 
-using Configs = ::testing::Types<EkfBatch, EkfSequential, EkfJoseph, SeifSparsified, SeifCoordinateDescent, Graph,
+using Configs = ::testing::Types<EkfBatch, EkfSequential, EkfJoseph, SeifSparsified, SeifRelocalization, SeifCoordinateDescent, Graph,
                                  FastSlamOne, FastSlamTwo>;
 TYPED_TEST_SUITE(StrongGuarantee, Configs);
 

@@ -15,6 +15,7 @@
 #include "sextant/core/backend_types.hpp"
 #include "sextant/core/landmark_store.hpp"
 #include "sextant/core/concepts.hpp"
+#include "sextant/core/conditionally_linear.hpp"
 #include "sextant/core/first_estimates.hpp"
 #include "sextant/core/observability_constraints.hpp"
 #include "sextant/core/gaussian.hpp"
@@ -38,8 +39,41 @@ enum class MeanRecovery {
   coordinate_descent,
 };
 
+/// How SEIF bounds the landmarks linked to the robot (docs/derivations/seif_relocalization.md).
+enum class SeifSparsification {
+  /// Thesis eqs. 37-44 (Thrun et al.): the robot's links to the landmarks leaving the active set are
+  /// dropped by an approximation that conditions on the passive landmarks; overconfident in the
+  /// global frame (Walter, Eustice and Leonard, IJRR 2007).
+  thesis,
+  /// The exactly sparse filter of Walter, Eustice and Leonard (ESEIF): when the active set would
+  /// overflow, the measurements of a few observed landmarks are held back, the robot is marginalized
+  /// out after the others are applied, and a new robot state is relocalized from the held-back
+  /// ones. Only information is discarded (conservative); needs measurements that determine the whole
+  /// robot state.
+  relocalization,
+};
+
+/// The mean that pose(), landmark() and map() report.
+enum class SeifEstimate {
+  /// The one the update keeps (recovered over the robot and the active landmarks; passive
+  /// landmarks keep the mean they had when they left the active set): the thesis's estimate.
+  recovered_mean,
+  /// Omega^-1 xi, the mean of the Gaussian the information form holds: one more solve with the
+  /// factor pose() and map() compute for the covariances anyway; the update stays O(1).
+  exact_mean,
+};
+
 struct SeifOptions {
   std::size_t max_active = 0;     ///< landmarks kept linked to the robot by sparsification; 0 = no sparsification
+  SeifSparsification sparsification = SeifSparsification::thesis;
+  /// Relocalization only: the held-back measurements must carry at least this share of the robot's
+  /// information given the map (Omega_xx) in every direction, else the step does not sparsify and
+  /// the active set stays over max_active until one can. A pose relocalized from two landmarks 0.2 m
+  /// apart seen from 5 m has a heading the next linearizations cannot trust; the sweep that chose
+  /// 0.05 (at most 20x less information, 4.5x the standard deviation) is in
+  /// docs/results/seif_relocalization.md.
+  double relocalization_min_information = 0.05;
+  SeifEstimate estimate = SeifEstimate::recovered_mean;
   MeanRecovery mean_recovery = MeanRecovery::active_block;
   int mean_recovery_sweeps = 1;   ///< sweeps per update (0 = none)
   int exact_recovery_period = 0;  ///< every K updates, an exact sparse solve of the whole mean; 0 = never
@@ -100,16 +134,17 @@ class SeifSlam {
   /// Solves Omega delta = r exactly (sparse Cholesky) and moves the whole mean to it.
   void recover_mean_exactly();
 
-  /// Pose mean (as recovered) with its marginal covariance by sparse solves with the Cholesky
+  /// Pose mean (SeifOptions::estimate) with its marginal covariance by sparse solves with the Cholesky
   /// factor of Omega, computed once per change of the filter (O(nnz of the factor)) and shared by
   /// pose(), landmark() and map().
   PoseEstimate pose() const;
-  /// The pose mean alone, O(1): pose() factorizes Omega, which fills in as the map grows.
+  /// The recovered pose mean alone, O(1): pose() factorizes Omega, which fills in as the map grows.
   const State& pose_mean() const { return x_; }
   LandmarkEstimate<M> landmark(LandmarkId id) const;
   MapEstimate map() const;
   /// The joint Gaussian of the robot and the landmarks `ids`, in that order (for data association,
-  /// core/data_association.hpp): one multi-column solve with the factor of Omega, X + M k columns.
+  /// core/data_association.hpp): one multi-column solve with the factor of Omega, X + M k columns;
+  /// the means are the recovered ones the update linearizes at.
   /// Throws unknown_landmark_error.
   JointMarginal<State, M> joint_marginal(std::span<const LandmarkId> ids) const;
   bool has_landmark(LandmarkId id) const { return landmarks_.contains(id); }
@@ -175,14 +210,28 @@ class SeifSlam {
   /// The squared pivots of the active block's factor when one was computed (active_block recovery).
   std::optional<Eigen::VectorXd> recover_mean_locally();
   void recover_mean_by_coordinate_descent();
-  Eigen::VectorXd recover_mean_of_active_block();
+  Eigen::VectorXd recover_mean_of_active_block() { return recover_mean_of_block(active_queue_); }
+  Eigen::VectorXd recover_mean_of_block(const std::vector<std::size_t>& slots);
   Eigen::MatrixXd robot_and_landmarks_block(const std::vector<std::size_t>& slots) const;
   void update_active_queue(const std::vector<std::size_t>& observed_slots);
+  /// ESEIF: the observations to relocalize the robot from, taken out of `observations`, when the
+  /// update would leave more than max_active landmarks linked to the robot and some of them
+  /// determine the robot state (else none: the active set overflows until a step can relocalize).
+  std::vector<MeasurementInformation> hold_back_for_relocalization(std::vector<Linearized>& observations,
+                                                                   std::size_t new_landmarks) const;
+  /// Omega' = Omega_mm - Omega_mx Omega_xx^-1 Omega_xm and r' likewise, over the active landmarks
+  /// only; leaves the robot with no information and no links.
+  void marginalize_robot();
+  void relocalize(const std::vector<MeasurementInformation>& held_back, std::vector<std::size_t> observed);
   /// The squared pivots of the Cholesky factor of S_xx when it sparsified.
   std::optional<Eigen::Matrix<double, X, 1>> sparsify();
   void require_factorizable_after_update(const std::optional<Eigen::VectorXd>& squared_pivots,
                                          const std::optional<Eigen::Matrix<double, X, 1>>& robot_squared_pivots) const;
   std::shared_ptr<const Factor> factorization() const;
+  /// What SeifOptions::estimate adds to the recovered means: Omega^-1 r (exact_mean) or nothing.
+  std::shared_ptr<const Eigen::VectorXd> estimate_correction() const;
+  State estimated_pose_mean() const;
+  Landmark estimated_landmark_mean(std::size_t slot) const;
   Eigen::MatrixXd marginal_covariance(Eigen::Index offset, Eigen::Index size) const;
   /// The joint covariance of the robot and the landmark blocks starting at `offsets`, in that order.
   Eigen::MatrixXd joint_covariance(const std::vector<Eigen::Index>& offsets) const;
@@ -202,6 +251,7 @@ class SeifSlam {
   std::uint64_t revision_ = 0;
   Undo* undo_ = nullptr;  ///< the open transaction's undo record
   VersionedCache<Factor> factor_;  ///< factorization of Omega at revision_ (thread-safe)
+  VersionedCache<Eigen::VectorXd> correction_;  ///< Omega^-1 r at revision_ (exact_mean only)
 };
 
 }  // namespace sextant

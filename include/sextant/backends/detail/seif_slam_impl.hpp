@@ -1,9 +1,12 @@
 #pragma once
 // Bodies of SeifSlam (see ../seif_slam.hpp).
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/SVD>
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <string>
 #include <unordered_set>
 #include <utility>
@@ -22,9 +25,15 @@ SeifSlam<Motion, Sensor>::SeifSlam(Motion motion, Sensor sensor, const PoseEstim
   if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
   const auto llt = cholesky_or_throw(prior.cov, "prior covariance");
   info_.robot() = symmetrized(llt.solve(Eigen::Matrix<double, X, X>::Identity()));
+  if (!(options_.relocalization_min_information >= 0.0) || !std::isfinite(options_.relocalization_min_information))
+    throw invalid_input_error("SeifOptions: relocalization_min_information must be finite and >= 0");
   if (options_.mean_recovery_sweeps < 0 || options_.exact_recovery_period < 0)
     throw invalid_input_error("SeifOptions: mean_recovery_sweeps and exact_recovery_period must be >= 0");
   gate_ = InnovationGate(Z, options_.gate_probability);
+  if (options_.sparsification == SeifSparsification::relocalization && conditionally_linear_dims_v<Motion> > 0)
+    throw invalid_input_error("SeifOptions: relocalization needs measurements that determine the whole robot state, and "
+                              "no measurement sees the last " +
+                              std::to_string(conditionally_linear_dims_v<Motion>) + " entries of this model's state");
 }
 
 /// Thesis eqs. (20)-(26) in error-state form, with Phi = G^-T Omega G^-1 and
@@ -147,6 +156,7 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
     if (auto lin = linearize(observation, result.unusable)) linearized.push_back(std::move(*lin));
   gate(linearized, result.rejected);
   result.corrected = linearized.size();
+  const auto relocalization = hold_back_for_relocalization(linearized, fresh.size());
   std::vector<MeasurementInformation> measurements;
   measurements.reserve(linearized.size());
   for (const auto& lin : linearized) measurements.push_back(measurement_information(lin));
@@ -169,6 +179,11 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
     times.measurement_s = seconds_since(stage_start);
     stage_start = Clock::now();
     ++updates_;
+    if (!relocalization.empty()) {
+      relocalize(relocalization, std::move(observed));
+      times.mean_recovery_s = seconds_since(stage_start);
+      return;
+    }
     update_active_queue(observed);  // first: mean recovery orders the active block by it
     std::optional<Eigen::VectorXd> squared_pivots;
     if (options_.exact_recovery_period > 0 && updates_ % static_cast<std::uint64_t>(options_.exact_recovery_period) == 0)
@@ -318,12 +333,11 @@ Eigen::MatrixXd SeifSlam<Motion, Sensor>::robot_and_landmarks_block(const std::v
   return D;
 }
 
-/// Solves Omega_BB delta_B = r_B for B = robot + active landmarks (in the queue's order), moves their
-/// means, and passes the change on to the residuals of their passive neighbours: r_b -= Omega_bB
-/// delta_B. Returns the squared diagonal of the Cholesky factor of Omega_BB.
+/// Solves Omega_BB delta_B = r_B for B = robot + `slots` (in that order; the active landmarks in the
+/// queue's order), moves their means, and passes the change on to the residuals of their neighbours
+/// outside B: r_b -= Omega_bB delta_B. Returns the squared diagonal of the Cholesky factor of Omega_BB.
 template <class Motion, class Sensor>
-Eigen::VectorXd SeifSlam<Motion, Sensor>::recover_mean_of_active_block() {
-  const std::vector<std::size_t>& slots = active_queue_;
+Eigen::VectorXd SeifSlam<Motion, Sensor>::recover_mean_of_block(const std::vector<std::size_t>& slots) {
   const Eigen::MatrixXd D = robot_and_landmarks_block(slots);
   Eigen::VectorXd r(D.rows());
   r.template head<X>() = info_.robot_residual();
@@ -386,6 +400,100 @@ void SeifSlam<Motion, Sensor>::recover_mean_exactly_in_transaction() {
   info_.set_residual(r - omega * delta);
 }
 
+/// Which observed landmarks relocalize the robot (ESEIF): up to max_active of them (the new active
+/// set), chosen greedily for the most information about the robot (largest log det of
+/// Lambda = sum H_x^T Q^-1 H_x, D-optimal), provided Lambda holds at least
+/// relocalization_min_information of the robot's information Omega_xx in every direction (the
+/// robot state is determined by them alone, well enough to stay where linearization holds). As many as the active set holds, the most informative first: a
+/// relocalized pose from the fewest that determine it (two range-bearing landmarks) tracked at 6x
+/// the EKF's error on kf-slam_demo, from eight in the order observed at 1.7x, from the eight most
+/// informative at 1.3x (docs/results/seif_relocalization.md).
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::hold_back_for_relocalization(std::vector<Linearized>& observations,
+                                                           std::size_t new_landmarks) const
+    -> std::vector<MeasurementInformation> {
+  using MatrixX = Eigen::Matrix<double, X, X>;
+  if (options_.sparsification != SeifSparsification::relocalization || options_.max_active == 0) return {};
+  std::unordered_set<std::size_t> active;
+  for (const auto& [slot, block] : info_.robot_links()) active.insert(slot);
+  for (const auto& lin : observations) active.insert(landmarks_.slot(lin.id));
+  if (active.size() + new_landmarks <= options_.max_active || observations.empty()) return {};
+  std::vector<MatrixX> about_robot;
+  MatrixX total = MatrixX::Zero();
+  for (const auto& lin : observations) total += about_robot.emplace_back(measurement_information(lin).xx);
+  const auto count = std::min(observations.size(), options_.max_active);
+  MatrixX chosen = 1e-12 * total.trace() / X * MatrixX::Identity();  // log det defined from the first pick
+  for (std::size_t k = 0; k < count; ++k) {
+    std::size_t best = k;
+    double best_log_det = -std::numeric_limits<double>::infinity();
+    for (std::size_t j = k; j < observations.size(); ++j) {
+      const double log_det = (chosen + about_robot[j]).ldlt().vectorD().array().log().sum();
+      if (log_det > best_log_det) best_log_det = log_det, best = j;
+    }
+    std::swap(observations[k], observations[best]);
+    std::swap(about_robot[k], about_robot[best]);
+    chosen += about_robot[k];
+  }
+  // Lambda_beta v = lambda Omega_xx v: the share of the robot's information (given the map) that the
+  // held-back measurements carry, in the direction where they carry least.
+  const Eigen::GeneralizedSelfAdjointEigenSolver<MatrixX> relative(chosen, info_.robot(), Eigen::EigenvaluesOnly);
+  if (!(relative.eigenvalues()(0) >= options_.relocalization_min_information)) return {};
+  const Eigen::SelfAdjointEigenSolver<MatrixX> eigen(chosen, Eigen::EigenvaluesOnly);
+  if (!(eigen.eigenvalues()(0) > 1e-9 * eigen.eigenvalues()(X - 1))) return {};
+  std::vector<MeasurementInformation> held;
+  for (std::size_t k = 0; k < count; ++k) held.push_back(measurement_information(observations[k]));
+  observations.erase(observations.begin(), observations.begin() + static_cast<std::ptrdiff_t>(count));
+  return held;
+}
+
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::marginalize_robot() {
+  const auto robot = cholesky_or_throw(info_.robot(), "robot block of the information matrix");
+  std::vector<std::pair<std::size_t, Eigen::Matrix<double, X, M>>> links(info_.robot_links().begin(),
+                                                                         info_.robot_links().end());
+  std::sort(links.begin(), links.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Eigen::Matrix<double, X, M>> solved;  // Omega_xx^-1 Omega_xi
+  for (const auto& [slot, block] : links) solved.push_back(robot.solve(block));
+  const Eigen::Matrix<double, X, 1> solved_r = robot.solve(info_.robot_residual());
+  for (std::size_t a = 0; a < links.size(); ++a) {
+    const auto& [i, L_i] = links[a];
+    info_.diagonal(i) = symmetrized((info_.diagonal(i) - L_i.transpose() * solved[a]).eval());
+    info_.landmark_residual(i) -= L_i.transpose() * solved_r;
+    for (std::size_t b = a + 1; b < links.size(); ++b) info_.add_to_link(i, links[b].first, -L_i.transpose() * solved[b]);
+  }
+  for (const auto& [slot, block] : links) info_.remove_robot_link(slot);
+  info_.robot().setZero();
+  info_.robot_residual().setZero();
+}
+
+/// ESEIF's sparsification (docs/derivations/seif_relocalization.md), after the other observations were
+/// added: the robot marginalized out, a new one from the held-back observations alone, and the mean
+/// recovered over it and every landmark the step touched (the landmarks just observed are passive
+/// now: the thesis's active block would leave their means where they were).
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::relocalize(const std::vector<MeasurementInformation>& held_back,
+                                          std::vector<std::size_t> observed) {
+  std::vector<std::size_t> touched = active_queue_;
+  touched.insert(touched.end(), observed.begin(), observed.end());
+  marginalize_robot();
+  for (const auto& info : held_back) {
+    add(info);
+    observed.insert(observed.begin(), info.slot);
+  }
+  update_active_queue(observed);
+  if (options_.exact_recovery_period > 0 && updates_ % static_cast<std::uint64_t>(options_.exact_recovery_period) == 0) {
+    recover_mean_exactly_in_transaction();
+    return require_factorizable_after_update(std::nullopt, std::nullopt);
+  }
+  std::vector<std::size_t> block = active_queue_;
+  std::unordered_set<std::size_t> in_block(block.begin(), block.end());
+  for (std::size_t slot : touched)
+    if (in_block.insert(slot).second) block.push_back(slot);
+  Eigen::VectorXd squared_pivots;
+  for (int sweep = 0; sweep < std::max(options_.mean_recovery_sweeps, 1); ++sweep) squared_pivots = recover_mean_of_block(block);
+  require_factorizable_after_update(squared_pivots, std::nullopt);
+}
+
 /// The thesis's queue (§3.5.4): landmarks observed now first, then the previously active ones in
 /// their previous order.
 template <class Motion, class Sensor>
@@ -407,6 +515,7 @@ void SeifSlam<Motion, Sensor>::update_active_queue(const std::vector<std::size_t
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::sparsify() -> std::optional<Eigen::Matrix<double, X, 1>> {
   if (options_.max_active == 0 || active_queue_.size() <= options_.max_active) return std::nullopt;
+  if (options_.sparsification == SeifSparsification::relocalization) return std::nullopt;  // waits for relocalize()
   const std::vector<std::size_t>& R = active_queue_;
   const std::size_t kept = options_.max_active;
   const Eigen::Index n_R = M * static_cast<Eigen::Index>(R.size());
@@ -455,6 +564,29 @@ auto SeifSlam<Motion, Sensor>::factorization() const -> std::shared_ptr<const Fa
   });
 }
 
+template <class Motion, class Sensor>
+std::shared_ptr<const Eigen::VectorXd> SeifSlam<Motion, Sensor>::estimate_correction() const {
+  if (options_.estimate != SeifEstimate::exact_mean) return nullptr;
+  return correction_.get(revision_, [&] {
+    auto correction = std::make_shared<Eigen::VectorXd>(factorization()->solve(info_.residual()));
+    if (!correction->allFinite()) throw numerical_error("SEIF exact mean is not finite");
+    return std::shared_ptr<const Eigen::VectorXd>(std::move(correction));
+  });
+}
+
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::estimated_pose_mean() const -> State {
+  const auto correction = estimate_correction();
+  return correction ? Space::plus(x_, correction->template head<X>().eval()) : x_;
+}
+
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::estimated_landmark_mean(std::size_t slot) const -> Landmark {
+  const auto correction = estimate_correction();
+  if (!correction) return landmark_mean(slot);
+  return landmark_mean(slot) + correction->template segment<M>(offset_of(slot));
+}
+
 /// A diagonal block of Omega^-1 from `size` sparse solves.
 template <class Motion, class Sensor>
 Eigen::MatrixXd SeifSlam<Motion, Sensor>::marginal_covariance(Eigen::Index offset, Eigen::Index size) const {
@@ -487,13 +619,13 @@ auto SeifSlam<Motion, Sensor>::joint_marginal(std::span<const LandmarkId> ids) c
 
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::pose() const -> PoseEstimate {
-  return {x_, marginal_covariance(0, X)};
+  return {estimated_pose_mean(), marginal_covariance(0, X)};
 }
 
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::landmark(LandmarkId id) const -> LandmarkEstimate<M> {
   const std::size_t slot = landmarks_.slot(id);
-  return {id, landmark_mean(slot), marginal_covariance(offset_of(slot), M)};
+  return {id, estimated_landmark_mean(slot), marginal_covariance(offset_of(slot), M)};
 }
 
 template <class Motion, class Sensor>
@@ -508,7 +640,7 @@ auto SeifSlam<Motion, Sensor>::map() const -> MapEstimate {
     unit.block(offset_of(first), 0, unit.cols(), unit.cols()).setIdentity();
     const Eigen::MatrixXd columns = factor->solve(unit);
     for (std::size_t k = 0; k < count; ++k)
-      out.push_back({landmarks_.id_at(first + k), landmark_mean(first + k),
+      out.push_back({landmarks_.id_at(first + k), estimated_landmark_mean(first + k),
                      symmetrized(columns.template block<M, M>(offset_of(first + k), M * k))});
   }
   return out;
