@@ -217,7 +217,7 @@ class SeifSlam {
   /// ESEIF: the observations to relocalize the robot from, taken out of `observations`, when the
   /// update would leave more than max_active landmarks linked to the robot and some of them
   /// determine the robot state (else none: the active set overflows until a step can relocalize).
-  std::vector<MeasurementInformation> hold_back_for_relocalization(std::vector<Linearized>& observations,
+  std::vector<MeasurementInformation> hold_back_for_relocalization(std::vector<MeasurementInformation>& observations,
                                                                    std::size_t new_landmarks) const;
   /// Omega' = Omega_mm - Omega_mx Omega_xx^-1 Omega_xm and r' likewise, over the active landmarks
   /// only; leaves the robot with no information and no links.

@@ -6,6 +6,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <unordered_set>
@@ -156,7 +157,6 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
     if (auto lin = linearize(observation, result.unusable)) linearized.push_back(std::move(*lin));
   gate(linearized, result.rejected);
   result.corrected = linearized.size();
-  const auto relocalization = hold_back_for_relocalization(linearized, fresh.size());
   std::vector<MeasurementInformation> measurements;
   measurements.reserve(linearized.size());
   for (const auto& lin : linearized) measurements.push_back(measurement_information(lin));
@@ -165,6 +165,7 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
   for (const auto& observation : fresh)
     if (auto landmark = new_landmark(observation, result.unusable)) landmarks.push_back(std::move(*landmark));
   result.initialized = landmarks.size();
+  const auto relocalization = hold_back_for_relocalization(measurements, fresh.size());
 
   atomically([&] {
     std::vector<std::size_t> observed;
@@ -409,30 +410,28 @@ void SeifSlam<Motion, Sensor>::recover_mean_exactly_in_transaction() {
 /// the EKF's error on kf-slam_demo, from eight in the order observed at 1.7x, from the eight most
 /// informative at 1.3x (docs/results/seif_relocalization.md).
 template <class Motion, class Sensor>
-auto SeifSlam<Motion, Sensor>::hold_back_for_relocalization(std::vector<Linearized>& observations,
+auto SeifSlam<Motion, Sensor>::hold_back_for_relocalization(std::vector<MeasurementInformation>& observations,
                                                            std::size_t new_landmarks) const
     -> std::vector<MeasurementInformation> {
   using MatrixX = Eigen::Matrix<double, X, X>;
   if (options_.sparsification != SeifSparsification::relocalization || options_.max_active == 0) return {};
   std::unordered_set<std::size_t> active;
   for (const auto& [slot, block] : info_.robot_links()) active.insert(slot);
-  for (const auto& lin : observations) active.insert(landmarks_.slot(lin.id));
+  for (const auto& info : observations) active.insert(info.slot);
   if (active.size() + new_landmarks <= options_.max_active || observations.empty()) return {};
-  std::vector<MatrixX> about_robot;
   MatrixX total = MatrixX::Zero();
-  for (const auto& lin : observations) total += about_robot.emplace_back(measurement_information(lin).xx);
+  for (const auto& info : observations) total += info.xx;
   const auto count = std::min(observations.size(), options_.max_active);
   MatrixX chosen = 1e-12 * total.trace() / X * MatrixX::Identity();  // log det defined from the first pick
   for (std::size_t k = 0; k < count; ++k) {
     std::size_t best = k;
     double best_log_det = -std::numeric_limits<double>::infinity();
     for (std::size_t j = k; j < observations.size(); ++j) {
-      const double log_det = (chosen + about_robot[j]).ldlt().vectorD().array().log().sum();
+      const double log_det = (chosen + observations[j].xx).ldlt().vectorD().array().log().sum();
       if (log_det > best_log_det) best_log_det = log_det, best = j;
     }
     std::swap(observations[k], observations[best]);
-    std::swap(about_robot[k], about_robot[best]);
-    chosen += about_robot[k];
+    chosen += observations[k].xx;
   }
   // Lambda_beta v = lambda Omega_xx v: the share of the robot's information (given the map) that the
   // held-back measurements carry, in the direction where they carry least.
@@ -440,9 +439,9 @@ auto SeifSlam<Motion, Sensor>::hold_back_for_relocalization(std::vector<Lineariz
   if (!(relative.eigenvalues()(0) >= options_.relocalization_min_information)) return {};
   const Eigen::SelfAdjointEigenSolver<MatrixX> eigen(chosen, Eigen::EigenvaluesOnly);
   if (!(eigen.eigenvalues()(0) > 1e-9 * eigen.eigenvalues()(X - 1))) return {};
-  std::vector<MeasurementInformation> held;
-  for (std::size_t k = 0; k < count; ++k) held.push_back(measurement_information(observations[k]));
-  observations.erase(observations.begin(), observations.begin() + static_cast<std::ptrdiff_t>(count));
+  const auto held_end = observations.begin() + static_cast<std::ptrdiff_t>(count);
+  std::vector<MeasurementInformation> held(std::make_move_iterator(observations.begin()), std::make_move_iterator(held_end));
+  observations.erase(observations.begin(), held_end);
   return held;
 }
 
