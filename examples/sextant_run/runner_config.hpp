@@ -34,6 +34,8 @@
 #include <string>
 #include <vector>
 
+#include "table_row.hpp"
+
 namespace sextant::runner {
 
 /// The globe experiment's settings; run_globe.cpp turns them into sim::GlobeCameraOptions (kept apart
@@ -47,6 +49,8 @@ struct GlobeSettings {
   std::vector<std::size_t> seif_active{150, 250, 0};  ///< one SEIF run per value (0 = all active)
   std::size_t covariance_period = 10;  ///< pose NEES every this many steps
   int graph_updates = 10;              ///< GraphSLAM global updates after the windowed initialization
+  /// globe-stereo and stereo:DIR: the back-end that tracks the images online and gates the association
+  BackendKind tracker = BackendKind::ekf;
 };
 
 /// The visual-inertial runs' settings (run_vislam.cpp): the models' noise for .npz data (the
@@ -232,6 +236,13 @@ inline const std::vector<ConfigKey>& config_keys() {
        }},
       {"globe", "covariance_period", "10", "NEES of the pose every this many steps (a SEIF's covariance costs a factorization)",
        [](RunnerConfig& c, const std::string& v) { c.globe.covariance_period = parse_integer<std::size_t>(v, 1); }},
+      {"globe", "tracker", "ekf",
+       "globe-stereo, stereo:DIR: the back-end that tracks the images and gates the association: ekf or seif (its "
+       "first seif_active value; its exact gate solves with the factor of Omega every frame)",
+       [](RunnerConfig& c, const std::string& v) {
+         if (v != "ekf" && v != "seif") throw invalid_input_error("'" + v + "' is not a tracker (ekf or seif)");
+         c.globe.tracker = v == "ekf" ? BackendKind::ekf : BackendKind::seif;
+       }},
       {"globe", "graph_updates", "10", "GraphSLAM global updates after the windowed initialization (thesis Table 10: 10)",
        [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = parse_integer<int>(v, 1, 1e4); }},
       {"vislam", "velocity_sigma", "0.5", "m/s: IMU linear velocity noise per axis (.npz data)",

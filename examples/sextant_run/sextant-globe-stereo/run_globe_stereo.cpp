@@ -2,12 +2,15 @@
 // (--dataset globe-stereo) or a user's rectified stereo sequence (--dataset stereo:<dir>), through the
 // OpenCV front-end (AKAZE, row matching, triangulation, association gated by the EKF's prediction,
 // the landmark pool) and then every back-end on the observations it produced.
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sextant/backends/ekf_slam.hpp>
+#include <sextant/backends/seif_slam.hpp>
 #include <sextant/io/csv_writer.hpp>
 #include <sextant/io/tum_writer.hpp>
 #include <sextant/sim/globe_render.hpp>
@@ -27,7 +30,6 @@
 namespace sextant::runner {
 namespace {
 
-using Tracker = vision::StereoTracker<EulerCamera12D>;
 using Observations = std::vector<Observation<Eigen::Vector3d>>;
 
 /// Sums over the frames of a run: the front-end's figures and the time per stage.
@@ -50,7 +52,7 @@ struct FrontEndTotals {
   }
 };
 
-void print_front_end(const FrontEndTotals& t, const eval::GlobeAssociationTruth* truth) {
+void print_front_end(const FrontEndTotals& t, const eval::GlobeAssociationTruth* truth, const std::string& tracker) {
   const double n = static_cast<double>(std::max<std::size_t>(t.frames, 1));
   std::printf("front-end over %zu frames: %.0f left keypoints, %.0f stereo matches, %.1f observations per frame "
               "(%.1f associated, %.1f proposed as new)",
@@ -59,7 +61,7 @@ void print_front_end(const FrontEndTotals& t, const eval::GlobeAssociationTruth*
     std::printf("; association precision %.4f (%zu of %zu right against the rendering)", truth->precision(),
                 truth->right(), truth->associated());
   std::printf("\n%-12s %9s %9s %11s %10s %12s %9s %10s\n", "ms/frame", "detect", "match", "triangulate", "associate",
-              "EKF back-end", "total", "frames/s");
+              (tracker + " back-end").c_str(), "total", "frames/s");
   const auto& s = t.times;
   std::printf("%-12s %9.2f %9.2f %11.3f %10.2f %12.2f %9.2f %10.2f\n", "", 1e3 * s.detect / n, 1e3 * s.match / n,
               1e3 * s.triangulate / n, 1e3 * s.associate / n, 1e3 * s.backend / n, 1e3 * s.total() / n,
@@ -81,7 +83,7 @@ void write_observations(const std::filesystem::path& dir, const std::vector<Obse
 }
 
 /// The README's picture: one rendered pair with the features the front-end handed on (green:
-/// associated with the map, orange: proposed as new) joined left to right; below, the EKF's map and
+/// associated with the map, orange: proposed as new) joined left to right; below, the tracker's map and
 /// trajectories seen from above (x-z) and from the side (x-y), the truth in white, the estimate in red.
 struct PictureFrame {
   cv::Mat left, right;
@@ -89,7 +91,8 @@ struct PictureFrame {
 };
 
 void draw_pipeline_picture(const std::filesystem::path& file, const PictureFrame& f, const std::vector<LandmarkEstimate<3>>& map,
-                           const std::vector<Vector12d>& truth, const std::vector<Vector12d>& estimate) {
+                           const std::vector<Vector12d>& truth, const std::vector<Vector12d>& estimate,
+                           const std::string& tracker) {
   const int w = f.left.cols, h = f.left.rows;
   cv::Mat canvas(2 * h, 2 * w, CV_8UC3, cv::Scalar(30, 30, 30));
   cv::cvtColor(f.left, canvas(cv::Rect(0, 0, w, h)), cv::COLOR_GRAY2BGR);
@@ -119,7 +122,7 @@ void draw_pipeline_picture(const std::filesystem::path& file, const PictureFrame
     cv::putText(canvas, title, cv::Point(x0 + 10, h + 25), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(230, 230, 230), 1,
                 cv::LINE_AA);
   };
-  panel(0, 0, 2, "from above (x-z): EKF map (blue), true path (white), EKF path (red)");
+  panel(0, 0, 2, ("from above (x-z): " + tracker + " map (blue), true path (white), " + tracker + " path (red)").c_str());
   panel(w, 0, 1, "from the side (x-y)");
   cv::putText(canvas, "left", cv::Point(10, 25), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(230, 230, 230), 1, cv::LINE_AA);
   cv::putText(canvas, "right: green associated, orange new", cv::Point(w + 10, 25), cv::FONT_HERSHEY_SIMPLEX, 0.6,
@@ -130,9 +133,31 @@ void draw_pipeline_picture(const std::filesystem::path& file, const PictureFrame
 vision::StereoTrackerOptions tracker_options(const RunnerConfig& c) {
   vision::StereoTrackerOptions o;
   o.pool = c.globe.pool;
-  o.ekf = c.ekf;
   o.association.max_observations = static_cast<std::size_t>(c.globe.features_per_frame);
   return o;
+}
+
+/// "EKF" -> "ekf": the back-end's key in output file names.
+std::string c_key(std::string name) {
+  for (char& ch : name) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return name;
+}
+
+/// Calls `run(tracker, name)` with the stereo tracker of [globe] tracker: the EKF with [ekf]'s
+/// options, or SEIF with [seif]'s and the first [globe] seif_active value.
+template <class Run>
+auto with_tracker(const RunnerConfig& c, const EulerCamera12D& motion, const PointInCamera3D& sensor,
+                  const Gaussian<Vector12d, 12>& prior, const vision::StereoRig& rig, int width, int height, Run&& run) {
+  if (c.globe.tracker == BackendKind::seif) {
+    SeifOptions seif = c.seif;
+    seif.max_active = c.globe.seif_active.front();
+    vision::StereoTracker<SeifSlam<EulerCamera12D, PointInCamera3D>> tracker(
+        {motion, sensor, prior, seif}, sensor, rig, width, height, tracker_options(c));
+    return run(tracker, std::string("SEIF"));
+  }
+  vision::StereoTracker<EkfSlam<EulerCamera12D, PointInCamera3D>> tracker({motion, sensor, prior, c.ekf}, sensor,
+                                                                           rig, width, height, tracker_options(c));
+  return run(tracker, std::string("EKF"));
 }
 
 vision::StereoCalibration calibration_of(const sim::GlobeCameraOptions& o, const Gaussian<Vector12d, 12>& prior) {
@@ -162,50 +187,52 @@ std::vector<TableRow> run_globe_stereo(const CliOptions& cli, const std::string&
               config.globe.pool.max_landmarks, config.globe.pool.max_new_per_step, config.globe.features_per_frame);
   const auto calibration = calibration_of(o, points.prior);
   if (!save_images.empty()) vision::write_calibration(save_images, calibration);
-  Tracker tracker(points.motion, points.sensor, points.prior, calibration.rig(), o.image_width, o.image_height,
-                  tracker_options(config));
-  eval::GlobeAssociationTruth truth(o);
-  FrontEndTotals totals;
-  sim::GlobeCameraDataset stereo = points;
-  std::vector<Observations> frames;
-  std::vector<std::vector<bool>> is_new;
-  std::vector<Vector12d> ekf_means;
-  PictureFrame picture;
-  const std::size_t picture_step = std::min<std::size_t>(100, points.steps.size() - 1);
-  ProgressBar progress("globe-stereo: render + front-end", points.steps.size());
-  for (std::size_t k = 0; k < points.steps.size(); ++k) {
-    const Vector12d& x = points.true_poses[k + 1];
-    const auto start = std::chrono::steady_clock::now();
-    const auto images = sim::render_stereo(o, x);
-    totals.render += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const cv::Mat left = vision::as_mat(images.left), right = vision::as_mat(images.right);
-    if (!save_images.empty()) vision::write_stereo_pair(save_images, k, left, right);
-    const auto tracked = tracker.track(left, right, {}, points.steps[k].dt);
-    truth.score(x, tracked);
-    totals.add(tracked);
-    stereo.steps[k].observations = tracked.observations;
-    frames.push_back(tracked.observations);
-    is_new.push_back(tracked.is_new);
-    ekf_means.push_back(tracker.backend().pose().mean);
-    if (k == picture_step) picture = {left.clone(), right.clone(), tracked};
-    progress.advance();
-  }
-  stereo.true_landmarks = truth.true_landmarks();
-  print_front_end(totals, &truth);
-  if (!save_images.empty()) std::printf("wrote the rendered sequence to %s (left/, right/, calib.yaml)\n", save_images.c_str());
-  if (!options.out.empty()) write_observations(std::filesystem::path(options.out) / "globe-stereo", frames, is_new);
-  if (options.plots) {
-    const auto file = std::filesystem::path(options.out) / "globe-stereo" / "pipeline.png";
-    const std::vector<Vector12d> truth_path(points.true_poses.begin() + 1, points.true_poses.end());
-    draw_pipeline_picture(file, picture, tracker.backend().map(), truth_path, ekf_means);
-    std::printf("wrote %s (frame %zu with its features, the EKF's map and trajectory)\n", file.c_str(), picture_step);
-  }
-  std::printf("\nevery back-end on the front-end's observations:\n");
-  auto rows = run_globe_dataset(options, "globe-stereo", stereo, kinds, config);
-  std::printf("\nfor comparison, the point simulator (--dataset globe) on the same trajectory, EKF:\n");
-  const auto reference = run_globe_dataset(options, "globe", points, {BackendKind::ekf}, config);
-  rows.insert(rows.end(), reference.begin(), reference.end());
-  return rows;
+  return with_tracker(config, points.motion, points.sensor, points.prior, calibration.rig(), o.image_width, o.image_height,
+                      [&](auto& tracker, const std::string& tracker_name) {
+    eval::GlobeAssociationTruth truth(o);
+    FrontEndTotals totals;
+    sim::GlobeCameraDataset stereo = points;
+    std::vector<Observations> frames;
+    std::vector<std::vector<bool>> is_new;
+    std::vector<Vector12d> tracked_means;
+    PictureFrame picture;
+    const std::size_t picture_step = std::min<std::size_t>(100, points.steps.size() - 1);
+    ProgressBar progress("globe-stereo: render + front-end", points.steps.size());
+    for (std::size_t k = 0; k < points.steps.size(); ++k) {
+      const Vector12d& x = points.true_poses[k + 1];
+      const auto start = std::chrono::steady_clock::now();
+      const auto images = sim::render_stereo(o, x);
+      totals.render += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const cv::Mat left = vision::as_mat(images.left), right = vision::as_mat(images.right);
+      if (!save_images.empty()) vision::write_stereo_pair(save_images, k, left, right);
+      const auto tracked = tracker.track(left, right, {}, points.steps[k].dt);
+      truth.score(x, tracked);
+      totals.add(tracked);
+      stereo.steps[k].observations = tracked.observations;
+      frames.push_back(tracked.observations);
+      is_new.push_back(tracked.is_new);
+      tracked_means.push_back(pose_mean_of(tracker.backend()));
+      if (k == picture_step) picture = {left.clone(), right.clone(), tracked};
+      progress.advance();
+    }
+    stereo.true_landmarks = truth.true_landmarks();
+    print_front_end(totals, &truth, tracker_name);
+    if (!save_images.empty()) std::printf("wrote the rendered sequence to %s (left/, right/, calib.yaml)\n", save_images.c_str());
+    if (!options.out.empty()) write_observations(std::filesystem::path(options.out) / "globe-stereo", frames, is_new);
+    if (options.plots) {
+      const auto file = std::filesystem::path(options.out) / "globe-stereo" / "pipeline.png";
+      const std::vector<Vector12d> truth_path(points.true_poses.begin() + 1, points.true_poses.end());
+      draw_pipeline_picture(file, picture, tracker.backend().map(), truth_path, tracked_means, tracker_name);
+      std::printf("wrote %s (frame %zu with its features, the %s's map and trajectory)\n", file.c_str(), picture_step,
+                  tracker_name.c_str());
+    }
+    std::printf("\nevery back-end on the front-end's observations:\n");
+    auto rows = run_globe_dataset(options, "globe-stereo", stereo, kinds, config);
+    std::printf("\nfor comparison, the point simulator (--dataset globe) on the same trajectory, EKF:\n");
+    const auto reference = run_globe_dataset(options, "globe", points, {BackendKind::ekf}, config);
+    rows.insert(rows.end(), reference.begin(), reference.end());
+    return rows;
+  });
 }
 
 /// A user's rectified sequence (left/*.png, right/*.png, calib.yaml): the front-end with EKF tracking.
@@ -219,34 +246,37 @@ std::vector<TableRow> run_stereo_directory(const CliOptions& cli, const std::str
   sensor.noise.focal_px = c.K(0, 0);
   sensor.noise.baseline = c.baseline;
   const auto prior = vision::initial_camera_estimate(c);
-  std::printf("\n== stereo:%s: %zu rectified pairs, %dx%d, f = %.1f px, baseline %.3f m, dt %.4f s; EKF tracking\n",
-              dir.c_str(), sequence.size(), c.width, c.height, c.K(0, 0), c.baseline, c.dt);
-  Tracker tracker(EulerCamera12D{}, sensor, prior, c.rig(), c.width, c.height, tracker_options(config));
-  FrontEndTotals totals;
-  std::vector<Observations> frames;
-  std::vector<std::vector<bool>> is_new;
-  std::vector<io::TumPose> trajectory;
-  ProgressBar progress("stereo: front-end", sequence.size());
-  for (std::size_t k = 0; k < sequence.size(); ++k) {
-    const auto [left, right] = sequence.load(k);
-    const auto tracked = tracker.track(left, right, {}, c.dt);
-    totals.add(tracked);
-    frames.push_back(tracked.observations);
-    is_new.push_back(tracked.is_new);
-    const Vector12d x = tracker.backend().pose().mean;
-    trajectory.push_back({c.dt * static_cast<double>(k + 1), x.head<3>(), Eigen::Quaterniond(euler_yxz::rotation(x.segment<3>(3)))});
-    progress.advance();
-  }
-  print_front_end(totals, nullptr);
-  std::printf("EKF at the end: %zu landmarks in the map; no ground truth with a stereo directory, so no error columns\n",
-              tracker.backend().landmark_ids().size());
-  if (!options.out.empty()) {
-    const auto out = std::filesystem::path(options.out) / "stereo";
-    write_observations(out, frames, is_new);
-    io::write_tum((out / "ekf_trajectory.tum").string(), trajectory);
-    std::printf("wrote observations.csv and ekf_trajectory.tum to %s\n", out.c_str());
-  }
-  return {};
+  return with_tracker(config, EulerCamera12D{}, sensor, prior, c.rig(), c.width, c.height,
+                      [&](auto& tracker, const std::string& tracker_name) {
+    std::printf("\n== stereo:%s: %zu rectified pairs, %dx%d, f = %.1f px, baseline %.3f m, dt %.4f s; %s tracking\n",
+                dir.c_str(), sequence.size(), c.width, c.height, c.K(0, 0), c.baseline, c.dt, tracker_name.c_str());
+    FrontEndTotals totals;
+    std::vector<Observations> frames;
+    std::vector<std::vector<bool>> is_new;
+    std::vector<io::TumPose> trajectory;
+    ProgressBar progress("stereo: front-end", sequence.size());
+    for (std::size_t k = 0; k < sequence.size(); ++k) {
+      const auto [left, right] = sequence.load(k);
+      const auto tracked = tracker.track(left, right, {}, c.dt);
+      totals.add(tracked);
+      frames.push_back(tracked.observations);
+      is_new.push_back(tracked.is_new);
+      const Vector12d x = pose_mean_of(tracker.backend());
+      trajectory.push_back({c.dt * static_cast<double>(k + 1), x.head<3>(), Eigen::Quaterniond(euler_yxz::rotation(x.segment<3>(3)))});
+      progress.advance();
+    }
+    print_front_end(totals, nullptr, tracker_name);
+    std::printf("%s at the end: %zu landmarks in the map; no ground truth with a stereo directory, so no error columns\n",
+                tracker_name.c_str(), tracker.backend().landmark_ids().size());
+    if (!options.out.empty()) {
+      const auto out = std::filesystem::path(options.out) / "stereo";
+      write_observations(out, frames, is_new);
+      const std::string file = c_key(tracker_name) + "_trajectory.tum";
+      io::write_tum((out / file).string(), trajectory);
+      std::printf("wrote observations.csv and %s to %s\n", file.c_str(), out.c_str());
+    }
+    return std::vector<TableRow>{};
+  });
 }
 
 const RegisterDatasetRun rendered_registration{"globe-stereo", run_globe_stereo};

@@ -95,6 +95,11 @@ class EkfSlam {
   PoseEstimate pose() const { return {x_, symmetric_diagonal_block<X>(cov_.view(), 0)}; }
   LandmarkEstimate<M> landmark(LandmarkId id) const { return landmark_at(landmarks_.slot(id)); }
   MapEstimate map() const;
+  /// Every landmark's id and mean, O(n): map() without its covariances (what a front-end needs to
+  /// find the landmarks in view before asking joint_marginal() for those).
+  std::vector<std::pair<LandmarkId, Landmark>> landmark_means() const {
+    return landmarks_.id_mean_pairs([&](std::size_t slot) { return landmark_mean(slot); });
+  }
   /// The joint Gaussian of the robot and the landmarks `ids`, in that order (for data association,
   /// core/data_association.hpp): a gather from P, O((X + M k)^2). Throws unknown_landmark_error.
   JointMarginal<State, M> joint_marginal(std::span<const LandmarkId> ids) const;

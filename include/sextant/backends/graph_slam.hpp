@@ -113,9 +113,7 @@ class GraphSlam {
   /// Every landmark's id and mean, O(n): map() without the selected inversion its covariances need
   /// (which costs much more when landmarks are seen from many poses, as in visual SLAM).
   std::vector<std::pair<LandmarkId, Landmark>> landmark_means() const {
-    std::vector<std::pair<LandmarkId, Landmark>> out;
-    for (std::size_t slot = 0; slot < landmarks_.size(); ++slot) out.emplace_back(landmarks_.id_at(slot), landmark_mean(slot));
-    return out;
+    return landmarks_.id_mean_pairs([&](std::size_t slot) { return landmark_mean(slot); });
   }
   bool has_landmark(LandmarkId id) const { return landmarks_.contains(id); }
   std::size_t num_landmarks() const { return landmarks_.size(); }

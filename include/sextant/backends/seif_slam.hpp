@@ -142,6 +142,11 @@ class SeifSlam {
   const State& pose_mean() const { return x_; }
   LandmarkEstimate<M> landmark(LandmarkId id) const;
   MapEstimate map() const;
+  /// Every landmark's id and mean (SeifOptions::estimate), O(n) with the recovered mean: map()
+  /// without its covariances.
+  std::vector<std::pair<LandmarkId, Landmark>> landmark_means() const {
+    return landmarks_.id_mean_pairs([&](std::size_t slot) { return estimated_landmark_mean(slot); });
+  }
   /// The joint Gaussian of the robot and the landmarks `ids`, in that order (for data association,
   /// core/data_association.hpp): one multi-column solve with the factor of Omega, X + M k columns;
   /// the means are the recovered ones the update linearizes at.

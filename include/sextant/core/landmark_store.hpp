@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "sextant/core/landmark_pool.hpp"
@@ -65,6 +66,14 @@ class LandmarkStore {
   Landmark first_mean(std::size_t slot) const { return first_means_.at(slot); }
   StackedMeans<M>& means() { return means_; }
   const StackedMeans<M>& means() const { return means_; }
+  /// Every landmark's id and mean in slot order, O(n): a back-end's landmark_means().
+  template <class Mean>
+  std::vector<std::pair<LandmarkId, Landmark>> id_mean_pairs(Mean&& mean_at) const {
+    std::vector<std::pair<LandmarkId, Landmark>> out;
+    out.reserve(size());
+    for (std::size_t slot = 0; slot < size(); ++slot) out.emplace_back(id_at(slot), mean_at(slot));
+    return out;
+  }
 
   /// Appends a landmark at `mean` (also its first mean); returns its slot. Throws
   /// duplicate_landmark_error, leaving the store as it was.

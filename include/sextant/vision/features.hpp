@@ -24,12 +24,16 @@ enum class Detector { kaze, akaze };
 struct DetectorOptions {
   Detector detector = Detector::akaze;
   float threshold = 0.001f;  ///< detector response threshold (OpenCV's default for both)
+  /// Sublevels per octave of the nonlinear scale space (OpenCV's default 4). AKAZE's time is mostly
+  /// building those levels: 2 halves it on the rendered globe; docs/results/real_time.md measures
+  /// what that does to the association and the map.
+  int octave_layers = 4;
 };
 
 inline cv::Ptr<cv::Feature2D> make_detector(const DetectorOptions& o) {
   if (o.detector == Detector::akaze)
-    return cv::AKAZE::create(cv::AKAZE::DESCRIPTOR_MLDB, 0, 3, o.threshold);
-  return cv::KAZE::create(false, true, o.threshold);  // upright: a rectified pair needs no rotation invariance
+    return cv::AKAZE::create(cv::AKAZE::DESCRIPTOR_MLDB, 0, 3, o.threshold, 4, o.octave_layers);
+  return cv::KAZE::create(false, true, o.threshold, 4, o.octave_layers);  // upright: a rectified pair needs no rotation invariance
 }
 
 /// Keypoints and descriptors of `image` (CV_8UC1). Throws invalid_input_error for an empty image

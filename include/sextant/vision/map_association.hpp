@@ -12,6 +12,7 @@
 #include <cmath>
 #include <limits>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <span>
 #include <unordered_map>
 #include <vector>
@@ -73,29 +74,49 @@ struct FrameAssociation {
 };
 
 /// The predicted measurement and innovation covariance of every landmark whose mean lies in front
-/// of the camera and projects inside the image (the only ones a feature can be). S comes from the
-/// back-end's joint marginal of the robot and that landmark (EKF: a gather of O(1) blocks per
-/// landmark; the cross terms between landmarks, which only a joint test would need, are never
-/// formed). Landmarks the model cannot predict or whose S is not positive definite are left out.
+/// of the camera and projects inside the image (the only ones a feature can be). The means come
+/// from the back-end's landmark_means() (O(n), no covariances); S from its joint marginal of the robot
+/// and each landmark: per landmark where that is a gather (EKF: O(1) blocks of P each), in one call
+/// for all of them where it is a solve (an information-form back-end such as SEIF: one multi-column
+/// solve with the factor of Omega instead of one per landmark). The cross terms between landmarks,
+/// which only a joint test would need, are not used. Landmarks the model cannot predict or whose S
+/// is not positive definite are left out.
 template <class Backend, class Sensor>
 std::vector<PredictedLandmark> predict_landmarks_in_view(const Backend& backend, const Sensor& sensor, const StereoRig& rig,
                                                          int width, int height) {
+  using Prediction = decltype(sensor.predict(pose_mean_of(backend), Eigen::Vector3d{}));
   const auto robot = pose_mean_of(backend);
-  std::vector<PredictedLandmark> out;
-  for (const auto& landmark : backend.map()) {
+  std::vector<LandmarkId> in_view;
+  std::vector<Prediction> predictions;
+  for (const auto& [id, mean] : backend.landmark_means()) {
+    std::optional<Prediction> p;
     try {
-      const auto p = sensor.predict(robot, landmark.mean);
-      const Eigen::Vector3d& q = p.z;
-      if (!(q.z() > 0.0) || !q.allFinite()) continue;
-      const double u = rig.cx + rig.focal_px * q.x() / q.z(), v = rig.cy + rig.focal_px * q.y() / q.z();
-      if (!(u >= 0.0 && u < width && v >= 0.0 && v < height)) continue;
-      const auto joint = backend.joint_marginal(std::span<const LandmarkId>(&landmark.id, 1));
-      const Eigen::Index a = joint.offset(0);
-      const Eigen::Matrix3d S = innovation_cross_block(joint.cov, p.J_z_x, p.J_z_m, a, p.J_z_x, p.J_z_m, a) + p.Q;
-      const Eigen::LLT<Eigen::Matrix3d> llt(S);
-      if (llt.info() != Eigen::Success) continue;
-      out.push_back({landmark.id, q, llt.solve(Eigen::Matrix3d::Identity())});
-    } catch (const numerical_error&) {
+      p = sensor.predict(robot, mean);
+    } catch (const numerical_error&) {  // the model cannot predict it here (e.g. the camera's gimbal lock)
+      continue;
+    }
+    const Eigen::Vector3d& q = p->z;
+    if (!(q.z() > 0.0) || !q.allFinite()) continue;
+    const double u = rig.cx + rig.focal_px * q.x() / q.z(), v = rig.cy + rig.focal_px * q.y() / q.z();
+    if (!(u >= 0.0 && u < width && v >= 0.0 && v < height)) continue;
+    in_view.push_back(id);
+    predictions.push_back(std::move(*p));
+  }
+  std::vector<PredictedLandmark> out;
+  auto add = [&](std::size_t i, const Eigen::MatrixXd& cov, Eigen::Index a) {
+    const auto& p = predictions[i];
+    const Eigen::Matrix3d S = innovation_cross_block(cov, p.J_z_x, p.J_z_m, a, p.J_z_x, p.J_z_m, a) + p.Q;
+    const Eigen::LLT<Eigen::Matrix3d> llt(S);
+    if (llt.info() == Eigen::Success) out.push_back({in_view[i], p.z, llt.solve(Eigen::Matrix3d::Identity())});
+  };
+  if (in_view.empty()) return out;
+  if constexpr (requires { backend.information_matrix(); }) {
+    const auto joint = backend.joint_marginal(std::span<const LandmarkId>(in_view));
+    for (std::size_t i = 0; i < in_view.size(); ++i) add(i, joint.cov, joint.offset(i));
+  } else {
+    for (std::size_t i = 0; i < in_view.size(); ++i) {
+      const auto joint = backend.joint_marginal(std::span<const LandmarkId>(&in_view[i], 1));
+      add(i, joint.cov, joint.offset(0));
     }
   }
   return out;

@@ -1,8 +1,9 @@
 #pragma once
-/// \file The full image-to-map step of the thesis's vSLAM framework: an EKF-SLAM through the
-/// bounded landmark pool tracks the camera, and its predictions gate the association of each new
-/// stereo frame's features with the map (vision/map_association.hpp). The observations it hands
-/// to its EKF, with their landmark ids, are the front-end's output: other back-ends replay them
+/// \file The full image-to-map step of the thesis's vSLAM framework: a filter through the bounded
+/// landmark pool tracks the camera (EKF-SLAM or SEIF-SLAM: any back-end with landmark_means() and
+/// joint_marginal()), and its predictions gate the association of each new stereo frame's features
+/// with the map (vision/map_association.hpp). The observations it hands to its back-end, with their
+/// landmark ids, are the front-end's output: other back-ends replay them
 /// (docs/results/globe_stereo.md says why one association serves them all).
 
 #include <chrono>
@@ -11,7 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "sextant/backends/ekf_slam.hpp"
+#include "sextant/core/observation.hpp"
+#include "sextant/core/update_result.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/landmark_pool_policy.hpp"
 #include "sextant/models/euler_camera_12d.hpp"
@@ -31,11 +33,10 @@ struct StereoTrackerOptions {
   LandmarkDescriptor descriptor = LandmarkDescriptor::first;
   MapAssociationOptions association{};
   PoolLimits pool{};
-  EkfOptions ekf{};
 };
 
-/// Seconds per stage of one frame: the front-end's three, then association and the EKF (motion,
-/// pool evictions and measurement update).
+/// Seconds per stage of one frame: the front-end's three, then association (with the back-end's
+/// predictions of the landmarks in view) and the back-end (motion, pool evictions and measurement update).
 struct TrackerTimes {
   double detect = 0.0, match = 0.0, triangulate = 0.0, associate = 0.0, backend = 0.0;
   double total() const { return detect + match + triangulate + associate + backend; }
@@ -50,20 +51,19 @@ struct TrackedFrame {
   TrackerTimes times;
 };
 
-template <class Motion, class Sensor = PointInCamera3D>
+/// Tracks with `Backend` (EkfSlam or SeifSlam over a camera motion model and `Sensor`).
+template <class Backend, class Sensor = PointInCamera3D>
 class StereoTracker {
  public:
-  using Backend = EkfSlam<Motion, Sensor>;
-  using Control = typename Motion::Control;
+  using Control = typename Backend::Control;
 
-  StereoTracker(Motion motion, Sensor sensor, const typename Backend::PoseEstimate& prior, StereoRig rig, int width,
-                int height, StereoTrackerOptions options = {})
-      : sensor_(sensor), ekf_(std::move(motion), sensor, prior, options.ekf), policy_(options.pool),
-        front_end_(rig, options.front_end), width_(width), height_(height), options_(options) {}
+  StereoTracker(Backend backend, Sensor sensor, StereoRig rig, int width, int height, StereoTrackerOptions options = {})
+      : sensor_(sensor), backend_(std::move(backend)), policy_(options.pool), front_end_(rig, options.front_end),
+        width_(width), height_(height), options_(options) {}
 
   /// One frame: features of the pair, motion update over dt, association, pool, measurement update.
   /// Bad images (empty, not 8-bit, sizes that differ) throw invalid_input_error before anything
-  /// changes; the EKF's own steps keep their strong guarantee, but a failed measurement update
+  /// changes; the back-end's own steps keep their strong guarantee, but a failed measurement update
   /// leaves the tracker after this frame's motion update, as eval::run_through_pool does.
   TrackedFrame track(const cv::Mat& left, const cv::Mat& right, const Control& control, double dt) {
     using Clock = std::chrono::steady_clock;
@@ -80,17 +80,17 @@ class StereoTracker {
     out.right_keypoints = frame.right_keypoints;
     out.stereo_matches = frame.features.size();
     auto start = Clock::now();
-    ekf_.predict(control, dt);
+    backend_.predict(control, dt);
     out.times.backend = seconds_since(start);
     start = Clock::now();
-    const auto predicted = predict_landmarks_in_view(ekf_, sensor_, front_end_.rig(), width_, height_);
+    const auto predicted = predict_landmarks_in_view(backend_, sensor_, front_end_.rig(), width_, height_);
     const auto association = associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance_,
                                               next_id_, options_.association);
     out.times.associate = seconds_since(start);
     out.predicted = predicted.size();
     out.gated_unmatched = association.gated_unmatched;
     start = Clock::now();
-    out.update = update_through_pool(ekf_, policy_, std::span<const Observation<Eigen::Vector3d>>(association.observations),
+    out.update = update_through_pool(backend_, policy_, std::span<const Observation<Eigen::Vector3d>>(association.observations),
                                      step_++);
     out.times.backend += seconds_since(start);
     remember_appearance(frame, association);
@@ -102,7 +102,7 @@ class StereoTracker {
     return out;
   }
 
-  const Backend& backend() const { return ekf_; }
+  const Backend& backend() const { return backend_; }
   const LandmarkPoolPolicy& pool() const { return policy_; }
   const StereoFrontEnd& front_end() const { return front_end_; }
 
@@ -124,7 +124,7 @@ class StereoTracker {
   }
 
   Sensor sensor_;
-  Backend ekf_;
+  Backend backend_;
   LandmarkPoolPolicy policy_;
   StereoFrontEnd front_end_;
   LandmarkAppearance appearance_;
