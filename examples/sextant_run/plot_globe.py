@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Plots of sextant-run's globe outputs: position and rotation error over time per back-end, their NEES
-at the sampled steps against the 95% bound (3 dof), and the landmark pool's bookkeeping (in pool,
-added, evicted per step; the thesis's Figures 22 and 25).
+at the sampled steps against the 95% bound (3 dof), the landmark pool's bookkeeping (in pool,
+added, evicted per step; the thesis's Figures 22 and 25) and each back-end's time per frame.
 Usage: plot_globe.py <dir with *_steps.csv>"""
 import csv
 import pathlib
@@ -49,6 +49,18 @@ def main():
     if nees:
         series_over_steps(nees, ("position_nees", "rotation_nees"), ("position NEES", "rotation-vector NEES"),
                           directory / "nees.png", log=True, bound=7.81)
+
+    fig, ax = plt.subplots(figsize=(9, 4))
+    for key, run in runs.items():
+        if "seconds" in run:
+            ax.semilogy(run["step"], [1e3 * max(v, 1e-6) for v in run["seconds"]], label=key, linewidth=0.8)
+    ax.axhline(1e3 / 15, color="black", linestyle="--", linewidth=0.8, label="15 frames/s")
+    ax.set_xlabel("frame")
+    ax.set_ylabel("ms per frame")
+    ax.set_title("time per frame (GraphSLAM: recording; its global updates are apart)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(directory / "frame_times.png", dpi=120)
 
     key, run = next(iter(runs.items()))
     fig, ax = plt.subplots(figsize=(9, 4))

@@ -1,10 +1,12 @@
 // sextant-run's globe part: the thesis's visual SLAM experiment (seed 000, §4.2.2, §5.2): the
 // 12D Euler-angle camera circling a simulated globe, every back-end through the bounded landmark
 // pool, one row per back-end as in Tables 8-10.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <sextant/eval/camera_scores.hpp>
 #include <sextant/eval/pooled_run.hpp>
@@ -31,6 +33,7 @@ sim::GlobeCameraOptions globe_options(const GlobeSettings& s) {
   o.num_steps = s.steps;
   o.num_points = s.points;
   o.max_features_per_frame = s.features_per_frame;
+  o.response_jitter = s.response_jitter;
   return o;
 }
 
@@ -50,6 +53,8 @@ struct GlobeRun {
   std::vector<PoolStepRecord> pool;
   std::vector<LandmarkEstimate<3>> map;
   double total_seconds = 0.0;
+  std::vector<double> step_seconds;  ///< each frame's predict + pool + update (GraphSLAM: recording it)
+  std::vector<double> graph_update_seconds;       ///< GraphSLAM: each global update
   std::vector<double> graph_update_position_mae;  ///< GraphSLAM: position MAE after each global update
   double marginal_seconds = 0.0;                  ///< GraphSLAM: recovering the marginals for the NEES
   std::vector<std::size_t> nees_steps;            ///< the step of each pose NEES in scores
@@ -80,6 +85,7 @@ GlobeRun run_filter(Backend& backend, const Dataset& data, const RunnerConfig& c
   out.means = std::move(run.means);
   out.pool = std::move(run.pool);
   out.total_seconds = run.total_seconds;
+  out.step_seconds = std::move(run.seconds);
   for (const auto& sampled : run.poses) out.nees_steps.push_back(sampled.step);
   return out;
 }
@@ -117,10 +123,12 @@ GlobeRun run_graph(Graph& graph, const Dataset& data, const RunnerConfig& c, std
   out.failures = run.failures;
   out.pool = std::move(run.pool);
   out.total_seconds = run.total_seconds;
+  out.step_seconds = std::move(run.seconds);
   for (int update = 0; update < c.globe.graph_updates; ++update) {
     const auto start = std::chrono::steady_clock::now();
     graph.optimize();
-    out.total_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    out.graph_update_seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    out.total_seconds += out.graph_update_seconds.back();
     // Means after each update (Table 10); the marginals once, after the last.
     std::vector<Vector12d> means(graph.pose_means().begin() + 1, graph.pose_means().end());
     out.map.clear();
@@ -177,6 +185,33 @@ std::vector<GlobeRun> run_backends(const Dataset& data, const std::vector<Backen
     if (failure) runs.push_back(failed_run<GlobeRun>(choice, *failure));  // its row says so; the others still run
   }
   return runs;
+}
+
+/// The q-quantile of `values` (nearest rank), NaN for none.
+double quantile(std::vector<double> values, double q) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto at = static_cast<std::size_t>(std::ceil(q * static_cast<double>(values.size()))) - 1;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(at), values.end());
+  return values[at];
+}
+
+/// Issue 37's real-time figures per row: milliseconds per frame, median, 95th percentile and the last
+/// frame (a filter's frame: predict, the pool, update; GraphSLAM records the frame and optimizes in
+/// global updates, whose mean is printed beside).
+void print_frame_times(const std::vector<GlobeRun>& runs) {
+  std::printf("%-27s %12s %12s %12s\n", "ms per frame", "median", "95th pct", "last");
+  for (const auto& r : runs) {
+    if (r.failure || r.step_seconds.empty()) continue;
+    std::printf("%-27s %12.2f %12.2f %12.2f", r.label.c_str(), 1e3 * quantile(r.step_seconds, 0.5),
+                1e3 * quantile(r.step_seconds, 0.95), 1e3 * r.step_seconds.back());
+    if (!r.graph_update_seconds.empty()) {
+      double sum = 0.0;
+      for (double t : r.graph_update_seconds) sum += t;
+      std::printf("   recording only; then %zu global updates, %.1f ms each",
+                  r.graph_update_seconds.size(), 1e3 * sum / static_cast<double>(r.graph_update_seconds.size()));
+    }
+    std::printf("\n");
+  }
 }
 
 void print_globe_header() {
@@ -244,12 +279,12 @@ void write_globe_outputs(const RunOptions& options, const std::string& name, con
   for (const auto& r : runs) {
     if (r.failure) continue;
     io::CsvWriter csv((dir / (r.key + "_steps.csv")).string(),
-                      {"step", "position_error", "rotation_error", "in_pool", "added", "evicted", "refused"});
+                      {"step", "position_error", "rotation_error", "in_pool", "added", "evicted", "refused", "seconds"});
     for (std::size_t k = 0; k < r.means.size(); ++k) {
       const PoolStepRecord pool = k < r.pool.size() ? r.pool[k] : PoolStepRecord{};
       csv.row({static_cast<double>(k + 1), r.scores.position_error[k], r.scores.rotation_error[k],
                static_cast<double>(pool.in_pool), static_cast<double>(pool.added), static_cast<double>(pool.evicted),
-               static_cast<double>(pool.refused)});
+               static_cast<double>(pool.refused), k < r.step_seconds.size() ? r.step_seconds[k] : 0.0});
     }
     std::vector<io::TumPose> estimate;
     mrpt_io::SceneContent scene;
@@ -287,6 +322,7 @@ std::vector<TableRow> run_globe_dataset(const RunOptions& options, const std::st
     rows.push_back(table_row(r, data.steps.size()));
     rows.back().dataset = name;
   }
+  print_frame_times(runs);
   for (const auto& r : runs) {
     if (r.graph_update_position_mae.empty()) continue;
     std::printf("GraphSLAM position MAE [mm] after each global update:");

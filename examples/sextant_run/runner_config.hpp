@@ -45,6 +45,7 @@ struct GlobeSettings {
   int steps = 500;                ///< thesis: 500
   int points = 3000;              ///< feature points on the globe
   int features_per_frame = 120;   ///< strongest visible points observed per frame
+  double response_jitter = 0.0;   ///< the detector's frame-to-frame response noise (sim::GlobeCameraOptions)
   PoolLimits pool{.max_landmarks = 1000, .max_new_per_step = 50};  ///< thesis: Mmax = 1000, 50 new per step
   std::vector<std::size_t> seif_active{150, 250, 0};  ///< one SEIF run per value (0 = all active)
   std::size_t covariance_period = 10;  ///< pose NEES every this many steps
@@ -222,6 +223,10 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.globe.points = parse_integer<int>(v, 1, 1e7); }},
       {"globe", "features_per_frame", "120", "strongest visible points observed per frame",
        [](RunnerConfig& c, const std::string& v) { c.globe.features_per_frame = parse_integer<int>(v, 1, 1e5); }},
+      {"globe", "response_jitter", "0",
+       "log-normal frame-to-frame noise of the detector's responses (0 = the same strongest points every frame; "
+       "1 with 20000 points and Mmax 10000: the thesis-scale run of docs/results/real_time.md)",
+       [](RunnerConfig& c, const std::string& v) { c.globe.response_jitter = non_negative(parse_number(v), v); }},
       {"globe", "max_landmarks", "1000", "landmark pool capacity Mmax (thesis: 1000)",
        [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_landmarks = parse_integer<std::size_t>(v, 1, 1e6); }},
       {"globe", "max_new_per_step", "50", "new landmarks per step at most (thesis: 50)",

@@ -102,21 +102,22 @@ TEST_F(RunnerCli, GlobeRunsEveryBackEndThroughThePoolAndWritesBookkeepingAndScen
   const auto r = run_runner("--dataset globe --config " + ini.string() + " --out " + out.string(), dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   for (const char* label : {"EKF-SLAM", "SEIF-SLAM, 20 active", "SEIF-SLAM, all active", "GraphSLAM, windows 50 x 5",
-                            "FastSLAM 1.0", "FastSLAM 2.0", "after each global update"})
+                            "FastSLAM 1.0", "FastSLAM 2.0", "after each global update", "ms per frame"})
     EXPECT_NE(r.out.find(label), std::string::npos) << label << " not in:\n" << r.out;
   EXPECT_EQ(r.out.find("nan"), std::string::npos) << "a score not computed must print as -:\n" << r.out;
   std::ifstream csv(out / "globe" / "ekf_steps.csv");
   std::string line;
   std::getline(csv, line);
-  EXPECT_EQ(line, "step,position_error,rotation_error,in_pool,added,evicted,refused");
+  EXPECT_EQ(line, "step,position_error,rotation_error,in_pool,added,evicted,refused,seconds");
   double evicted = 0.0, most_in_pool = 0.0;
   int rows = 0;
   while (std::getline(csv, line)) {
     std::vector<double> v;
     std::stringstream fields(line);
     for (std::string f; std::getline(fields, f, ',');) v.push_back(std::stod(f));
-    ASSERT_EQ(v.size(), 7u);
+    ASSERT_EQ(v.size(), 8u);
     EXPECT_LE(v[3], 45.0) << "pool over capacity at step " << v[0];
+    EXPECT_GT(v[7], 0.0) << "no time recorded for step " << v[0];
     EXPECT_LE(v[4], 10.0) << "more than max_new added at step " << v[0];
     evicted += v[5];
     most_in_pool = std::max(most_in_pool, v[3]);
