@@ -80,7 +80,7 @@ struct FrameAssociation {
 /// for all of them where it is a solve (an information-form back-end such as SEIF: one multi-column
 /// solve with the factor of Omega instead of one per landmark). The cross terms between landmarks,
 /// which only a joint test would need, are not used. Landmarks the model cannot predict or whose S
-/// is not positive definite are left out.
+/// is not positive definite are left out; an Omega that cannot be factorized throws numerical_error.
 template <class Backend, class Sensor>
 std::vector<PredictedLandmark> predict_landmarks_in_view(const Backend& backend, const Sensor& sensor, const StereoRig& rig,
                                                          int width, int height) {
