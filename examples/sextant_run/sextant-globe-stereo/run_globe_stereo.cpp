@@ -2,7 +2,6 @@
 // (--dataset globe-stereo) or a user's rectified stereo sequence (--dataset stereo:<dir>), through the
 // OpenCV front-end (AKAZE, row matching, triangulation, association gated by the EKF's prediction,
 // the landmark pool) and then every back-end on the observations it produced.
-#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -137,12 +136,6 @@ vision::StereoTrackerOptions tracker_options(const RunnerConfig& c) {
   return o;
 }
 
-/// "EKF" -> "ekf": the back-end's key in output file names.
-std::string c_key(std::string name) {
-  for (char& ch : name) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  return name;
-}
-
 /// Calls `run(tracker, name)` with the stereo tracker of [globe] tracker: the EKF with [ekf]'s
 /// options, or SEIF with [seif]'s and the first [globe] seif_active value.
 template <class Run>
@@ -271,7 +264,7 @@ std::vector<TableRow> run_stereo_directory(const CliOptions& cli, const std::str
     if (!options.out.empty()) {
       const auto out = std::filesystem::path(options.out) / "stereo";
       write_observations(out, frames, is_new);
-      const std::string file = c_key(tracker_name) + "_trajectory.tum";
+      const std::string file = backend_key(config.globe.tracker) + "_trajectory.tum";
       io::write_tum((out / file).string(), trajectory);
       std::printf("wrote observations.csv and %s to %s\n", file.c_str(), out.c_str());
     }

@@ -212,6 +212,10 @@ class SeifSlam {
   void require_finite_robot_and_active(const char* what) const;
   void require_factorizable_robot_and_active(const char* what) const;
   void recover_mean_exactly_in_transaction();
+  /// This update is one of every exact_recovery_period-th (SeifOptions): its mean is recovered exactly.
+  bool exact_recovery_due() const {
+    return options_.exact_recovery_period > 0 && updates_ % static_cast<std::uint64_t>(options_.exact_recovery_period) == 0;
+  }
   /// The squared pivots of the active block's factor when one was computed (active_block recovery).
   std::optional<Eigen::VectorXd> recover_mean_locally();
   void recover_mean_by_coordinate_descent();

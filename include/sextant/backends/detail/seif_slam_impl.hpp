@@ -187,7 +187,7 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
     }
     update_active_queue(observed);  // first: mean recovery orders the active block by it
     std::optional<Eigen::VectorXd> squared_pivots;
-    if (options_.exact_recovery_period > 0 && updates_ % static_cast<std::uint64_t>(options_.exact_recovery_period) == 0)
+    if (exact_recovery_due())
       recover_mean_exactly_in_transaction();
     else
       squared_pivots = recover_mean_locally();
@@ -480,7 +480,7 @@ void SeifSlam<Motion, Sensor>::relocalize(const std::vector<MeasurementInformati
     observed.insert(observed.begin(), info.slot);
   }
   update_active_queue(observed);
-  if (options_.exact_recovery_period > 0 && updates_ % static_cast<std::uint64_t>(options_.exact_recovery_period) == 0) {
+  if (exact_recovery_due()) {
     recover_mean_exactly_in_transaction();
     return require_factorizable_after_update(std::nullopt, std::nullopt);
   }
