@@ -10,7 +10,9 @@
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <optional>
 #include <sextant/backends/ekf_slam.hpp>
 #include <sextant/backends/graph_slam.hpp>
@@ -51,13 +53,21 @@ std::pair<double, double> fitted_line(const std::vector<double>& per_step) {
   return {slope, (st - slope * si) / n};
 }
 
+/// The q-quantile of `values` (nearest rank).
+double quantile(std::vector<double> values, double q) {
+  const auto at = static_cast<std::size_t>(std::ceil(q * static_cast<double>(values.size()))) - 1;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(at), values.end());
+  return values[at];
+}
+
 /// Stage times summed over the run, and the time of each step.
 struct StageTimes {
   double motion = 0, measurement = 0, mean_recovery = 0, sparsification = 0;
   std::vector<double> per_step;
 };
 
-void add_seif_stages(const Ekf&, StageTimes&) {}
+template <class Backend>
+void add_seif_stages(const Backend&, StageTimes&) {}
 void add_seif_stages(const Seif& seif, StageTimes& times) {
   times.mean_recovery += seif.last_update_times().mean_recovery_s;
   times.sparsification += seif.last_update_times().sparsification_s;
@@ -90,6 +100,8 @@ void run_timed(Backend& backend, benchmark::State& state) {
   state.counters["fit_slope_s"] = slope;
   state.counters["fit_intercept_s"] = intercept;
   state.counters["last_step_s"] = times.per_step.back();
+  state.counters["median_step_s"] = quantile(times.per_step, 0.5);
+  state.counters["p95_step_s"] = quantile(times.per_step, 0.95);
   state.counters["landmarks"] = static_cast<double>(policy.size());
   state.counters["steps"] = static_cast<double>(data.steps.size());
 }
@@ -121,6 +133,22 @@ void BM_GlobeSeif120Steps(benchmark::State& state) {
     run_timed(seif, state);
   }
   state.counters["active"] = static_cast<double>(state.range(0));
+}
+
+/// GraphSLAM online (GraphOptions::incremental): one Gauss-Newton step a frame on the incrementally
+/// factorized reduced pose system. Counters as the filters' (median, 95th percentile, last step),
+/// and global_update_s: one batch Gauss-Newton iteration over the same graph right after the run,
+/// the work a batch GraphSLAM would do for a current estimate at that frame.
+void BM_GlobeGraphOnline120Steps(benchmark::State& state) {
+  const auto& data = real_scale_globe();
+  for (auto _ : state) {
+    GraphSlam<EulerCamera12D, PointInCamera3D> graph(data.motion, data.sensor, data.prior,
+                                                     {.max_iterations = 1, .incremental = true});
+    run_timed(graph, state);
+    const auto start = Clock::now();
+    graph.optimize();
+    state.counters["global_update_s"] = seconds_since(start);
+  }
 }
 
 void BM_GlobeGraphOneGlobalUpdate(benchmark::State& state) {
@@ -211,6 +239,7 @@ void BM_GlobeEkfUpdateAtFinalSize(benchmark::State& state) {
 BENCHMARK(BM_GlobeEkf120Steps)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GlobeEkfUpdateAtFinalSize)->Iterations(3)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GlobeSeif120Steps)->Arg(150)->Arg(250)->Arg(1000)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK(BM_GlobeGraphOnline120Steps)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GlobeGraphOneGlobalUpdate)->Iterations(3)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GlobeGraphMarginals)
     ->ArgsProduct({{30, 60, 100}, {0, 1}})

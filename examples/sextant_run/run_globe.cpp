@@ -146,7 +146,7 @@ GlobeRun run_graph(Graph& graph, const Dataset& data, const RunnerConfig& c, std
 
 /// The globe's back-end configurations: SEIF once per [globe] seif_active; GraphSLAM as the thesis
 /// ran it, windowed initialization (windows of 50 steps, 5 iterations each), then one global update
-/// per optimize().
+/// per optimize(), and/or online ([globe] graph).
 std::vector<BackendChoice> globe_choices(const std::vector<BackendKind>& kinds, const RunnerConfig& c) {
   std::vector<BackendChoice> choices;
   for (auto choice : backend_choices<Motion>(kinds, c)) {
@@ -161,10 +161,17 @@ std::vector<BackendChoice> globe_choices(const std::vector<BackendKind>& kinds, 
       continue;
     }
     if (choice.kind == BackendKind::graph) {
+      BackendChoice online = choice;
       choice.graph.max_iterations = 1;
       choice.graph.window = 50;
       choice.graph.window_iterations = 5;
       choice.label = "GraphSLAM, windows 50 x 5";
+      if (c.globe.graph_batch) choices.push_back(choice);
+      online.graph.incremental = true;
+      online.key = "graph_online";
+      online.label = "GraphSLAM, online";
+      if (c.globe.graph_online) choices.push_back(std::move(online));
+      continue;
     }
     choices.push_back(std::move(choice));
   }
@@ -176,8 +183,9 @@ std::vector<GlobeRun> run_backends(const Dataset& data, const std::vector<Backen
   for (const auto& choice : globe_choices(kinds, c)) {
     const auto failure = failure_of([&] {
       with_backend(choice, data.motion, data.sensor, data.prior, [&](auto& backend) {
-        if constexpr (requires { backend.optimize(); })
-          runs.push_back(run_graph(backend, data, c, choice.key, choice.label));
+        if constexpr (requires { backend.optimize(); })  // online: run and scored as a filter is
+          runs.push_back(choice.graph.incremental ? run_filter(backend, data, c, choice.key, choice.label)
+                                                  : run_graph(backend, data, c, choice.key, choice.label));
         else
           runs.push_back(run_filter(backend, data, c, choice.key, choice.label));
       });

@@ -50,6 +50,8 @@ struct GlobeSettings {
   std::vector<std::size_t> seif_active{150, 250, 0};  ///< one SEIF run per value (0 = all active)
   std::size_t covariance_period = 10;  ///< pose NEES every this many steps
   int graph_updates = 10;              ///< GraphSLAM global updates after the windowed initialization
+  bool graph_batch = true;             ///< [globe] graph: the thesis's batch GraphSLAM row
+  bool graph_online = false;           ///< [globe] graph: the online (incremental) GraphSLAM row
   /// globe-stereo and stereo:DIR: the back-end that tracks the images online and gates the association
   BackendKind tracker = BackendKind::ekf;
 };
@@ -250,6 +252,15 @@ inline const std::vector<ConfigKey>& config_keys() {
        }},
       {"globe", "graph_updates", "10", "GraphSLAM global updates after the windowed initialization (thesis Table 10: 10)",
        [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = parse_integer<int>(v, 1, 1e4); }},
+      {"globe", "graph", "batch",
+       "batch (the thesis's: record, then global updates) | online (one incremental Gauss-Newton step a frame, "
+       "[graph] relinearize_threshold) | both (a row each)",
+       [](RunnerConfig& c, const std::string& v) {
+         if (v != "batch" && v != "online" && v != "both")
+           throw invalid_input_error("'" + v + "' is not a GraphSLAM mode (batch, online or both)");
+         c.globe.graph_batch = v != "online";
+         c.globe.graph_online = v != "batch";
+       }},
       {"vislam", "velocity_sigma", "0.5", "m/s: IMU linear velocity noise per axis (.npz data)",
        [](RunnerConfig& c, const std::string& v) { c.vislam.velocity_sigma = positive(parse_number(v), v); }},
       {"vislam", "rate_sigma", "0.05", "rad/s: IMU angular velocity noise per axis (.npz data)",
@@ -422,6 +433,9 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.graph.levenberg_marquardt = parse_bool(v); }},
       {"graph", "window", "0", "windowed initialization: optimize growing parts of this many steps first; 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.graph.window = parse_integer<std::size_t>(v, 0); }},
+      {"graph", "relinearize_threshold", "0.1",
+       "online mode: relinearize a variable when its step exceeds this share of its standard deviation",
+       [](RunnerConfig& c, const std::string& v) { c.graph.relinearize_threshold = positive(parse_number(v), v); }},
       {"pose_graph", "start", "file", "file (its vertices) | spanning_tree (of the odometry) | chordal (relaxation)",
        [](RunnerConfig& c, const std::string& v) {
          c.pose_graph_start = parse_choice<PoseGraphStart>(

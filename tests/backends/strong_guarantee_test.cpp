@@ -152,6 +152,11 @@ struct SeifCoordinateDescent {
 struct Graph {
   static auto make() { return GraphSlam<FaultyMotion, FaultySensor>{FaultyMotion{}, FaultySensor{}, test::kLinearPrior}; }
 };
+struct GraphOnline {
+  static auto make() {
+    return GraphSlam<FaultyMotion, FaultySensor>{FaultyMotion{}, FaultySensor{}, test::kLinearPrior, {.incremental = true}};
+  }
+};
 struct FastSlamOne {
   static auto make() {
     return FastSlam<FaultyMotion, FaultySensor>{FaultyMotion{}, FaultySensor{}, test::kLinearPrior,
@@ -220,7 +225,7 @@ class StrongGuarantee : public ::testing::Test {
 };
 
 using Configs = ::testing::Types<EkfBatch, EkfSequential, EkfJoseph, SeifSparsified, SeifRelocalization, SeifCoordinateDescent, Graph,
-                                 FastSlamOne, FastSlamTwo>;
+                                 GraphOnline, FastSlamOne, FastSlamTwo>;
 TYPED_TEST_SUITE(StrongGuarantee, Configs);
 
 /// 10 steps on the linear test problem, a removal every third step (the removed id comes back

@@ -15,6 +15,7 @@
 #include "sextant/core/landmark_store.hpp"
 #include "sextant/core/rollback_guard.hpp"
 #include "sextant/core/concepts.hpp"
+#include "sextant/core/factor_information.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/landmark_pool.hpp"
 #include "sextant/core/robust_kernel.hpp"
@@ -23,6 +24,7 @@
 #include "sextant/core/state_space.hpp"
 #include "sextant/core/update_result.hpp"
 #include "sextant/core/versioned_cache.hpp"
+#include "sextant/backends/detail/graph_slam_online_state.hpp"
 
 namespace sextant {
 
@@ -53,6 +55,14 @@ struct GraphOptions {
   /// On measurement factors (outliers of a real sensor): Huber or Cauchy by iteratively reweighted
   /// Gauss-Newton (core/robust_kernel.hpp); none = plain least squares. Motion factors stay quadratic.
   RobustLoss measurement_loss{};
+  /// Online mode (docs/derivations/incremental_graph_slam.md): every update() adds the frame's factors
+  /// to the reduced pose system, refactorizes it from the oldest pose they reach (core/profile_cholesky.hpp)
+  /// and takes one Gauss-Newton step, so that pose() and map() are smoothed after every frame.
+  bool incremental = false;
+  /// Online mode: a variable is relinearized when its step from its linearization point exceeds this
+  /// share of its standard deviation in some coordinate: a pose's as it entered the graph (dead
+  /// reckoning from the previous estimate), a landmark's given the poses (its information diagonal).
+  double relinearize_threshold = 0.1;
 };
 
 /// What optimize() reports.
@@ -105,6 +115,8 @@ class GraphSlam {
   /// optimize(), propagated by the motion model (G P G^T + R) through the poses added since, the
   /// uncertainty of the dead-reckoned mean that pose holds until the next optimize(). Measurements
   /// recorded since the last optimize() do not shrink it. trajectory() gives exact marginals.
+  /// Online mode: after each update() the mean is the step's estimate and the covariance the newest
+  /// pose's marginal in the linearized system (one block of the incremental factor).
   PoseEstimate pose() const { return {poses_.back(), newest_cov_}; }
   /// Every pose x_0 .. x_K with its marginal covariance.
   std::vector<PoseEstimate> trajectory() const;
@@ -127,6 +139,8 @@ class GraphSlam {
   const GraphOptions& options() const { return options_; }
   /// Symbolic analyses done by the sparse solver so far (it keeps one while the pattern is unchanged).
   int symbolic_analyses() const { return solver_.analyses(); }
+  /// Online mode: what the last update() did (rows refactorized, variables relinearized).
+  const OnlineStepSummary& last_online_step() const { return online_.last_step; }
 
  private:
   struct MotionRecord {
@@ -145,8 +159,22 @@ class GraphSlam {
     Eigen::VectorXd eta;
   };
   struct Linearization;  // defined in the implementation
+  using Online = OnlineGraphState<X, M, State>;
+  struct PriorInformation {
+    Eigen::Matrix<double, X, X> Lambda;
+    Eigen::Matrix<double, X, 1> g;
+    double cost;
+  };
 
-  BetweenFactor<X> motion_factor(std::size_t k) const;
+  template <class Inits>
+  void record_measurements(std::size_t pose, const std::vector<const ObservationType*>& used, const Inits& inits);
+  BetweenFactor<X> motion_factor(std::size_t k, const State& from, const State& to) const;
+  FactorInformation<X, X> motion_information(std::size_t k, const State& from, const State& to) const;
+  PriorInformation prior_information_at(const State& x0) const;
+  template <class PoseAt>
+  typename Online::PoseFactor marginal_information(const LinearFactor& factor, PoseAt&& pose_at) const;
+  std::optional<FactorInformation<X, M>> measurement_information(std::size_t slot, const Measurement& z, const State& x,
+                                                                 const Landmark& m) const;
   template <int D>
   static void require_factorizable_extension(const Eigen::Matrix<double, X, X>& P, const Eigen::Matrix<double, D, X>& J,
                                              const Eigen::Matrix<double, D, D>& C, const std::string& what);
@@ -169,6 +197,21 @@ class GraphSlam {
   Eigen::Matrix<double, X, X> newest_pose_marginal(const Linearization& system);
   Landmark landmark_mean(std::size_t slot) const { return landmarks_.mean(slot); }
   void touch() { ++revision_; }
+  // Online mode (graph_slam_online_impl.hpp)
+  struct OnlinePlan;
+  void step_online(const std::vector<std::size_t>& touched_slots);
+  void plan_linearization_points(OnlinePlan& plan) const;
+  void plan_pose_factors(OnlinePlan& plan) const;
+  void stage_online_factors(OnlinePlan& plan);
+  void plan_estimate(OnlinePlan& plan, const Eigen::VectorXd& delta_poses) const;
+  void commit_online_step(OnlinePlan& plan);
+  typename Online::LandmarkLinearization linearize_landmark_online(std::size_t slot, const OnlinePlan& plan) const;
+  typename Online::PoseFactor linearize_pose_factor_online(const typename Online::PoseFactor& which,
+                                                           const OnlinePlan& plan) const;
+  void restart_online() { online_ = Online{}; }
+  LinearFactor marginal_factor(std::size_t slot) const;
+  LinearFactor online_marginal_factor(std::size_t slot) const;
+  void remove_landmark_online(std::size_t slot, std::optional<typename Online::PoseFactor> held);
 
   Motion motion_;
   Sensor sensor_;
@@ -183,13 +226,16 @@ class GraphSlam {
   bool windows_done_ = false;
   std::uint64_t revision_ = 0;
   Eigen::Matrix<double, X, X> newest_cov_;  ///< see pose()
+  std::vector<Eigen::Matrix<double, X, 1>> entry_sigma_;  ///< each pose's standard deviations as it was added (online mode)
   mutable SparseCholesky solver_;  ///< keeps the symbolic analysis while the pattern is unchanged (non-const paths only)
   VersionedCache<SelectedInverse> marginals_;  ///< at revision_ (thread-safe)
+  Online online_;  ///< the incrementally factorized reduced system (online mode)
 };
 
 }  // namespace sextant
 
 #include "sextant/backends/detail/graph_slam_impl.hpp"
+#include "sextant/backends/detail/graph_slam_online_impl.hpp"
 
 // Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
 // are declared extern when the program links sextant::compiled.

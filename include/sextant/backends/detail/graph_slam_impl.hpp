@@ -64,8 +64,11 @@ GraphSlam<Motion, Sensor>::GraphSlam(Motion motion, Sensor sensor, const PoseEst
       cholesky_or_throw(prior.cov, "prior covariance").solve(Eigen::Matrix<double, X, X>::Identity()));
   if (options_.max_iterations < 1 || options_.window_iterations < 1)
     throw invalid_input_error("GraphOptions: max_iterations and window_iterations must be >= 1");
+  if (!(options_.relinearize_threshold > 0.0) || !std::isfinite(options_.relinearize_threshold))
+    throw invalid_input_error("GraphOptions: relinearize_threshold must be positive and finite");
   options_.measurement_loss.validate();
   poses_.push_back(prior.mean);
+  entry_sigma_.push_back(prior.cov.diagonal().cwiseSqrt());
 }
 
 template <class Motion, class Sensor>
@@ -82,6 +85,7 @@ void GraphSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   require_factorizable_extension<X>(prior_.cov, prediction.J_x_x, prediction.R, "GraphSLAM: the new pose");
   motions_.push_back({u, dt});
   poses_.push_back(prediction.x);
+  entry_sigma_.push_back(newest_cov.diagonal().cwiseMax(0.0).cwiseSqrt());
   newest_cov_ = newest_cov;
   touch();
 }
@@ -111,16 +115,39 @@ UpdateResult GraphSlam<Motion, Sensor>::update(std::span<const ObservationType> 
                                       "GraphSLAM: new landmark " + std::to_string(observation.landmark_id));
     inits.emplace_back(&observation, std::move(*init));
   }
-  for (const ObservationType* observation : used)
-    measurements_[landmarks_.slot(observation->landmark_id)].push_back({pose, observation->z});
-  for (const auto& [observation, init] : inits) {
-    landmarks_.add(observation->landmark_id, init.m);
-    measurements_.push_back({{pose, observation->z}});
-  }
+  record_measurements(pose, used, inits);
   touch();
   result.corrected = used.size();
   result.initialized = inits.size();
   return result;
+}
+
+/// Records the frame's measurements (new landmarks at their inverse-model means); in online mode
+/// also takes the online step, and forgets the records again if that throws.
+template <class Motion, class Sensor>
+template <class Inits>
+void GraphSlam<Motion, Sensor>::record_measurements(std::size_t pose, const std::vector<const ObservationType*>& used,
+                                                    const Inits& inits) {
+  const std::size_t old_slots = landmarks_.size();
+  std::vector<std::size_t> touched;
+  for (const ObservationType* observation : used) {
+    touched.push_back(landmarks_.slot(observation->landmark_id));
+    measurements_[touched.back()].push_back({pose, observation->z});
+  }
+  for (const auto& [observation, init] : inits) {
+    touched.push_back(landmarks_.add(observation->landmark_id, init.m));
+    measurements_.push_back({{pose, observation->z}});
+  }
+  if (!options_.incremental) return;
+  try {
+    step_online(touched);
+  } catch (...) {
+    for (std::size_t i = 0; i < used.size(); ++i) measurements_[touched[i]].pop_back();
+    measurements_.resize(old_slots);
+    landmarks_.truncate(old_slots);
+    touch();
+    throw;
+  }
 }
 
 /// The model's prediction, or nothing where it cannot predict (unobservable_error).
@@ -155,19 +182,28 @@ void GraphSlam<Motion, Sensor>::require_factorizable_extension(const Eigen::Matr
   require_well_conditioned(joint, what + ": its joint covariance with the newest pose");
 }
 
-/// The motion factor between poses k and k + 1: the model's own between() when it has one, else
-/// r = minus(x_k+1, g(x_k, u)) with covariance R (thesis eqs. 60-61) and the Jacobians of minus:
-/// J_to = D1, J_from = D2 G (D1 = I, D2 = -I in an additive chart; core/state_space.hpp).
+/// The motion factor between poses k and k + 1 at `from` and `to`: the model's own between() when
+/// it has one, else r = minus(to, g(from, u)) with covariance R (thesis eqs. 60-61) and the Jacobians
+/// of minus: J_to = D1, J_from = D2 G (D1 = I, D2 = -I in an additive chart; core/state_space.hpp).
 template <class Motion, class Sensor>
-BetweenFactor<GraphSlam<Motion, Sensor>::X> GraphSlam<Motion, Sensor>::motion_factor(std::size_t k) const {
+BetweenFactor<GraphSlam<Motion, Sensor>::X> GraphSlam<Motion, Sensor>::motion_factor(std::size_t k, const State& from,
+                                                                                      const State& to) const {
   if constexpr (HasBetweenFactor<Motion>) {
-    return motion_.between(poses_[k], poses_[k + 1], motions_[k].u, motions_[k].dt);
+    return motion_.between(from, to, motions_[k].u, motions_[k].dt);
   } else {
-    const auto prediction = motion_.predict(poses_[k], motions_[k].u, motions_[k].dt);
-    const State& next = poses_[k + 1];
-    return {Space::minus(next, prediction.x), minus_jacobian_second<Space>(next, prediction.x) * prediction.J_x_x,
-            minus_jacobian_first<Space>(next, prediction.x), prediction.R};
+    const auto prediction = motion_.predict(from, motions_[k].u, motions_[k].dt);
+    return {Space::minus(to, prediction.x), minus_jacobian_second<Space>(to, prediction.x) * prediction.J_x_x,
+            minus_jacobian_first<Space>(to, prediction.x), prediction.R};
   }
+}
+
+/// The motion factor's information over (from, to) (eqs. 60-61).
+template <class Motion, class Sensor>
+FactorInformation<GraphSlam<Motion, Sensor>::X, GraphSlam<Motion, Sensor>::X> GraphSlam<Motion, Sensor>::motion_information(
+    std::size_t k, const State& from, const State& to) const {
+  const BetweenFactor<X> factor = motion_factor(k, from, to);
+  const GaussianNoise<X> noise(factor.cov, "process noise of step " + std::to_string(k));
+  return noise.information(factor.J_from, factor.J_to, (-factor.r).eval());
 }
 
 /// The normal equations at the current estimate, factor by factor (core/factor_information.hpp):
@@ -187,29 +223,33 @@ auto GraphSlam<Motion, Sensor>::linearize(std::size_t pose_count) const -> Linea
   return sys;
 }
 
-/// The prior on the first pose, r = minus(x_0, mu_0) (eq. 64), its Jacobian D = d minus / d x_0
+/// The prior on the first pose at x0, r = minus(x0, mu_0) (eq. 64), its Jacobian D = d minus / d x0
 /// (the identity in an additive chart, where the product below is skipped to keep every bit).
 template <class Motion, class Sensor>
-void GraphSlam<Motion, Sensor>::add_prior_factor(Linearization& sys) const {
-  const Eigen::Matrix<double, X, 1> r0 = Space::minus(poses_[0], prior_.mean);
+auto GraphSlam<Motion, Sensor>::prior_information_at(const State& x0) const -> PriorInformation {
+  const Eigen::Matrix<double, X, 1> r0 = Space::minus(x0, prior_.mean);
+  const double cost = r0.dot(prior_information_ * r0);
   if constexpr (has_minus_jacobians_v<Space, State>) {
-    const Eigen::Matrix<double, X, X> D = minus_jacobian_first<Space>(poses_[0], prior_.mean);
-    sys.pose_diagonal[0] += D.transpose() * prior_information_ * D;
-    sys.pose_rhs.template head<X>() -= D.transpose() * (prior_information_ * r0);
+    const Eigen::Matrix<double, X, X> D = minus_jacobian_first<Space>(x0, prior_.mean);
+    return {D.transpose() * prior_information_ * D, -(D.transpose() * (prior_information_ * r0)), cost};
   } else {
-    sys.pose_diagonal[0] += prior_information_;
-    sys.pose_rhs.template head<X>() -= prior_information_ * r0;
+    return {prior_information_, -(prior_information_ * r0), cost};
   }
-  sys.cost += r0.dot(prior_information_ * r0);
+}
+
+template <class Motion, class Sensor>
+void GraphSlam<Motion, Sensor>::add_prior_factor(Linearization& sys) const {
+  const PriorInformation prior = prior_information_at(poses_[0]);
+  sys.pose_diagonal[0] += prior.Lambda;
+  sys.pose_rhs.template head<X>() += prior.g;
+  sys.cost += prior.cost;
 }
 
 /// Each motion factor between poses k and k + 1: residual r, Jacobians J_from, J_to (eqs. 60-61).
 template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::add_motion_factors(Linearization& sys) const {
   for (std::size_t k = 0; k + 1 < sys.pose_count; ++k) {
-    const BetweenFactor<X> factor = motion_factor(k);
-    const GaussianNoise<X> noise(factor.cov, "process noise of step " + std::to_string(k));
-    const auto info = noise.information(factor.J_from, factor.J_to, (-factor.r).eval());
+    const auto info = motion_information(k, poses_[k], poses_[k + 1]);
     sys.pose_diagonal[k] += info.aa;
     sys.pose_diagonal[k + 1] += info.bb;
     sys.pose_links.push_back({k, k + 1, info.ab});
@@ -219,43 +259,63 @@ void GraphSlam<Motion, Sensor>::add_motion_factors(Linearization& sys) const {
   }
 }
 
-/// The linear factors that marginalized landmarks left on their poses (remove_landmark), relinearized
-/// by the poses' moves since: b = eta - Lambda d, d = minus(x, linearization point), read in each
+/// A linear factor that a marginalized landmark left on its poses (remove_landmark), relinearized by
+/// the poses' moves since: g = eta - Lambda d, d = minus(x, linearization point), read in each
 /// pose's tangent through D = d minus / d x (block-diagonal; the identity in an additive chart).
+/// pose_at(p) gives the state of pose p to evaluate at.
+template <class Motion, class Sensor>
+template <class PoseAt>
+auto GraphSlam<Motion, Sensor>::marginal_information(const LinearFactor& factor, PoseAt&& pose_at) const ->
+    typename Online::PoseFactor {
+  const std::size_t count = factor.poses.size();
+  Eigen::VectorXd d(X * static_cast<Eigen::Index>(count));
+  for (std::size_t i = 0; i < count; ++i)
+    d.template segment<X>(X * i) = Space::minus(pose_at(factor.poses[i]), factor.linearization[i]);
+  typename Online::PoseFactor out{Online::Source::marginal, 0, factor.poses, factor.Lambda, factor.eta - factor.Lambda * d,
+                                  d.dot(factor.Lambda * d) - 2.0 * factor.eta.dot(d)};
+  if constexpr (has_minus_jacobians_v<Space, State>) {
+    Eigen::MatrixXd D = Eigen::MatrixXd::Zero(d.size(), d.size());
+    for (std::size_t i = 0; i < count; ++i)
+      D.template block<X, X>(X * i, X * i) = minus_jacobian_first<Space>(pose_at(factor.poses[i]), factor.linearization[i]);
+    out.g = (D.transpose() * out.g).eval();
+    out.Lambda = D.transpose() * factor.Lambda * D;
+  }
+  return out;
+}
+
 template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::add_marginal_factors(Linearization& sys) const {
   for (const auto& factor : linear_factors_) {
     if (*std::max_element(factor.poses.begin(), factor.poses.end()) >= sys.pose_count) continue;
+    const auto info = marginal_information(factor, [&](std::size_t p) -> const State& { return poses_[p]; });
     const std::size_t count = factor.poses.size();
-    Eigen::VectorXd d(X * static_cast<Eigen::Index>(count));
-    for (std::size_t i = 0; i < count; ++i)
-      d.template segment<X>(X * i) = Space::minus(poses_[factor.poses[i]], factor.linearization[i]);
-    Eigen::VectorXd b = factor.eta - factor.Lambda * d;
-    Eigen::MatrixXd in_current_tangents;  // D^T Lambda D where the chart needs it
-    if constexpr (has_minus_jacobians_v<Space, State>) {
-      Eigen::MatrixXd D = Eigen::MatrixXd::Zero(d.size(), d.size());
-      for (std::size_t i = 0; i < count; ++i)
-        D.template block<X, X>(X * i, X * i) = minus_jacobian_first<Space>(poses_[factor.poses[i]], factor.linearization[i]);
-      b = (D.transpose() * b).eval();
-      in_current_tangents = D.transpose() * factor.Lambda * D;
-    }
-    const Eigen::MatrixXd& Lambda = has_minus_jacobians_v<Space, State> ? in_current_tangents : factor.Lambda;
     for (std::size_t i = 0; i < count; ++i) {
-      sys.pose_rhs.template segment<X>(X * factor.poses[i]) += b.template segment<X>(X * i);
+      sys.pose_rhs.template segment<X>(X * factor.poses[i]) += info.g.template segment<X>(X * i);
       for (std::size_t k = 0; k < count; ++k) {
-        const Eigen::Matrix<double, X, X> block = Lambda.template block<X, X>(X * i, X * k);
+        const Eigen::Matrix<double, X, X> block = info.Lambda.template block<X, X>(X * i, X * k);
         if (factor.poses[i] == factor.poses[k])
           sys.pose_diagonal[factor.poses[i]] += block;
         else if (factor.poses[i] < factor.poses[k])
           sys.pose_links.push_back({factor.poses[i], factor.poses[k], block});
       }
     }
-    sys.cost += d.dot(factor.Lambda * d) - 2.0 * factor.eta.dot(d);
+    sys.cost += info.cost;
   }
 }
 
-/// Each measurement of each landmark: innovation nu = residual(z, h(x, m)), Jacobians J_z_x, J_z_m
-/// (eqs. 62-63), down-weighted by the measurement loss.
+/// One measurement z of the landmark in `slot` at pose x and landmark m: innovation
+/// nu = residual(z, h(x, m)), Jacobians J_z_x, J_z_m (eqs. 62-63), down-weighted by the measurement
+/// loss; nothing where the model cannot predict it (e.g. an iterate put the landmark behind the camera).
+template <class Motion, class Sensor>
+auto GraphSlam<Motion, Sensor>::measurement_information(std::size_t slot, const Measurement& z, const State& x,
+                                                        const Landmark& m) const -> std::optional<FactorInformation<X, M>> {
+  const auto prediction = predict_if_observable(x, m);
+  if (!prediction) return std::nullopt;
+  const GaussianNoise<Z> noise(prediction->Q, "measurement noise Q of landmark " + std::to_string(landmarks_.id_at(slot)));
+  return noise.information(prediction->J_z_x, prediction->J_z_m, sensor_.residual(z, prediction->z), options_.measurement_loss);
+}
+
+/// Each measurement of each landmark (eqs. 62-63); one the model cannot evaluate sits this one out.
 template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::add_measurement_factors(Linearization& sys) const {
   for (std::size_t slot = 0; slot < measurements_.size(); ++slot) {
@@ -263,20 +323,17 @@ void GraphSlam<Motion, Sensor>::add_measurement_factors(Linearization& sys) cons
     terms.slot = slot;
     for (const auto& record : measurements_[slot]) {
       if (record.pose >= sys.pose_count) continue;
-      const auto prediction = predict_if_observable(poses_[record.pose], landmark_mean(slot));
-      if (!prediction) {  // e.g. an iterate put the landmark behind this camera: the factor sits this one out
+      const auto info = measurement_information(slot, record.z, poses_[record.pose], landmark_mean(slot));
+      if (!info) {
         ++sys.unobservable;
         continue;
       }
-      const GaussianNoise<Z> noise(prediction->Q, "measurement noise Q of landmark " + std::to_string(landmarks_.id_at(slot)));
-      const auto info = noise.information(prediction->J_z_x, prediction->J_z_m,
-                                          sensor_.residual(record.z, prediction->z), options_.measurement_loss);
-      sys.pose_diagonal[record.pose] += info.aa;
-      sys.pose_rhs.template segment<X>(X * record.pose) += info.a;
-      terms.diagonal += info.bb;
-      terms.rhs += info.b;
-      terms.poses.emplace_back(record.pose, info.ab);
-      sys.cost += options_.measurement_loss.cost(info.squared_norm);
+      sys.pose_diagonal[record.pose] += info->aa;
+      sys.pose_rhs.template segment<X>(X * record.pose) += info->a;
+      terms.diagonal += info->bb;
+      terms.rhs += info->b;
+      terms.poses.emplace_back(record.pose, info->ab);
+      sys.cost += options_.measurement_loss.cost(info->squared_norm);
     }
     if (!terms.poses.empty()) sys.landmarks.push_back(std::move(terms));
   }
@@ -477,6 +534,7 @@ OptimizationSummary GraphSlam<Motion, Sensor>::optimize() {
     OptimizationSummary summary = gauss_newton(poses_.size(), options_.max_iterations, &final_system);
     newest_cov_ = newest_pose_marginal(final_system);
     guard.commit();
+    restart_online();  // the next update() linearizes the online system at the optimum
     touch();
     return summary;
   } catch (...) {
@@ -498,14 +556,15 @@ void GraphSlam<Motion, Sensor>::warm_start(std::span<const State> poses, const M
   poses_.assign(poses.begin(), poses.end());
   landmarks_.means().stacked() = means;
   windows_done_ = true;
+  restart_online();
   touch();
 }
 
 /// Marginalization of a landmark (thesis Appendix C) at the current estimate: its measurement
 /// factors over (poses P, landmark j) become Lambda = A_PP - A_Pj A_jj^-1 A_jP, eta = b_P - A_Pj A_jj^-1 b_j.
 template <class Motion, class Sensor>
-void GraphSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
-  const std::size_t slot = landmarks_.slot(id);
+auto GraphSlam<Motion, Sensor>::marginal_factor(std::size_t slot) const -> LinearFactor {
+  const LandmarkId id = landmarks_.id_at(slot);
   std::map<std::size_t, std::size_t> index;  // pose -> position in the factor
   for (const auto& record : measurements_[slot]) index.emplace(record.pose, 0);
   std::size_t next = 0;
@@ -534,8 +593,26 @@ void GraphSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
   }
   factor.Lambda = symmetrized(A_PP - A_Pj * llt.solve(A_Pj.transpose()));
   factor.eta = b_P - A_Pj * llt.solve(b_j);
-  linear_factors_.push_back(std::move(factor));
+  return factor;
+}
 
+/// In online mode the landmark's factor is its contribution to the reduced system at the
+/// linearization points, which stays in S as a factor on its poses (no refactorization).
+template <class Motion, class Sensor>
+void GraphSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
+  const std::size_t slot = landmarks_.slot(id);
+  const bool online = options_.incremental && !online_.theta.empty();
+  std::optional<LinearFactor> factor;
+  std::optional<typename Online::PoseFactor> held;  // online: the factor's blocks of S
+  if (!online) {
+    factor = marginal_factor(slot);
+  } else if (!online_.landmarks[slot].terms.empty()) {
+    factor = online_marginal_factor(slot);
+    held = marginal_information(*factor, [&](std::size_t p) -> const State& { return online_.theta[p]; });
+    held->index = linear_factors_.size();
+  }
+  if (factor) linear_factors_.push_back(std::move(*factor));
+  if (online) remove_landmark_online(slot, std::move(held));
   const auto removal = landmarks_.remove(id);
   measurements_[removal.freed_slot] = std::move(measurements_[removal.last_slot]);
   measurements_.pop_back();

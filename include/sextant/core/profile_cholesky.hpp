@@ -1,0 +1,225 @@
+#pragma once
+/// \file An incremental Cholesky factorization S = L L^T of a symmetric positive definite matrix of
+/// B x B blocks in profile (envelope) storage: block row i keeps its blocks from its first non-zero
+/// column first_i to the diagonal. The factor's fill stays inside the envelope of S (George and
+/// Liu, "Computer Solution of Large Sparse Positive Definite Systems", 1981, ch. 4), and rows before
+/// the first changed one keep their factor: if S changes only in rows and columns >= e, then
+/// L[:e, :] and L[e:, :e] are unchanged and
+///     L[e:, e:] = chol(S[e:, e:] - L[e:, :e] L[e:, :e]^T).
+/// Rows in chronological order (the poses of an online smoother) make e the oldest pose a new
+/// factor reaches: the work of a step depends on how far back it reaches, not on how many rows
+/// precede (docs/derivations/incremental_graph_slam.md). The trailing block is factorized densely
+/// (Eigen's blocked LLT).
+///
+/// Changes are a transaction: add() and append_row() stage copies of the rows they touch,
+/// factorize() computes the staged matrix's factor (solve() and last_inverse_block() then use it),
+/// commit() keeps both, discard() drops them (matrix and factor exactly as before). factorize()
+/// throws numerical_error and discards when the staged matrix is not positive definite.
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <algorithm>
+#include <cstddef>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sextant/core/error.hpp"
+
+namespace sextant {
+
+template <int B>
+class ProfileCholesky {
+ public:
+  using Block = Eigen::Matrix<double, B, B>;
+  using Vector = Eigen::VectorXd;
+
+  /// Block rows of the committed matrix.
+  std::size_t rows() const { return matrix_.size(); }
+  /// Block rows including the staged ones.
+  std::size_t staged_rows() const { return staged_count_; }
+  /// The first block row the staged changes touch (rows() when nothing is staged).
+  std::size_t first_changed() const { return first_changed_; }
+
+  /// Stages a new block row (zero; it must get a positive definite diagonal before factorize()).
+  void append_row() {
+    staged_index_.push_back(static_cast<long>(staged_rows_.size()));
+    staged_rows_.push_back(Row{staged_count_, Eigen::Matrix<double, B, Eigen::Dynamic>::Zero(B, B)});
+    staged_ids_.push_back(staged_count_);
+    first_changed_ = std::min(first_changed_, staged_count_);
+    ++staged_count_;
+  }
+
+  /// Stages S_ij += block for i >= j (the diagonal block i == j is added whole and must be symmetric).
+  void add(std::size_t i, std::size_t j, const Block& block) {
+    if (j > i || i >= staged_count_) throw invalid_input_error("ProfileCholesky::add: block (" + std::to_string(i) + ", " + std::to_string(j) + ") is not in the lower triangle of the matrix");
+    Row& row = staged_row(i);
+    if (j < row.first) extend_left(row, j);
+    row.blocks.template middleCols<B>(B * static_cast<Eigen::Index>(j - row.first)) += block;
+    first_changed_ = std::min(first_changed_, j);
+  }
+
+  /// Factorizes the staged matrix from its first changed row (the factor stays staged); throws
+  /// numerical_error, and discards, if it is not positive definite.
+  void factorize() {
+    try {
+      staged_factor_ = factorized_trailing_rows();
+      factorized_ = true;
+    } catch (...) {
+      discard();
+      throw;
+    }
+  }
+
+  /// Keeps the staged matrix and its factor (factorize() first).
+  void commit() {
+    if (!factorized_) throw std::logic_error("ProfileCholesky::commit before factorize");
+    matrix_.resize(staged_count_);
+    for (std::size_t k = 0; k < staged_ids_.size(); ++k) matrix_[staged_ids_[k]] = std::move(staged_rows_[k]);
+    factor_.resize(first_changed_);
+    for (auto& row : staged_factor_) factor_.push_back(std::move(row));
+    discard();
+  }
+
+  /// Drops the staged changes.
+  void discard() {
+    for (std::size_t i : staged_ids_)
+      if (i < staged_index_.size()) staged_index_[i] = -1;
+    staged_index_.resize(matrix_.size(), -1);
+    staged_rows_.clear();
+    staged_ids_.clear();
+    staged_factor_.clear();
+    factorized_ = false;
+    staged_count_ = matrix_.size();
+    first_changed_ = matrix_.size();
+  }
+
+  /// x with S x = b (the staged factor after factorize(), else the committed one), by one forward
+  /// and one backward substitution.
+  Vector solve(const Vector& b) const {
+    const std::size_t n = factor_rows();
+    Vector y(b.size());
+    for (std::size_t i = 0; i < n; ++i) {
+      const Row& row = factor_row(i);
+      const Eigen::Index first = B * static_cast<Eigen::Index>(row.first), width = B * static_cast<Eigen::Index>(i) - first;
+      Eigen::Matrix<double, B, 1> r = b.template segment<B>(B * static_cast<Eigen::Index>(i));
+      r.noalias() -= row.blocks.leftCols(width) * y.segment(first, width);
+      y.template segment<B>(B * static_cast<Eigen::Index>(i)) = diagonal(row).template triangularView<Eigen::Lower>().solve(r);
+    }
+    Vector x = y;  // accumulates y - L^T x as the rows below are solved
+    for (std::size_t i = n; i-- > 0;) {
+      const Row& row = factor_row(i);
+      const Eigen::Index first = B * static_cast<Eigen::Index>(row.first), width = B * static_cast<Eigen::Index>(i) - first;
+      auto xi = x.template segment<B>(B * static_cast<Eigen::Index>(i));
+      xi = diagonal(row).transpose().template triangularView<Eigen::Upper>().solve(Eigen::Matrix<double, B, 1>(xi));
+      x.segment(first, width).noalias() -= row.blocks.leftCols(width).transpose() * xi;
+    }
+    return x;
+  }
+
+  /// The block of S^-1 at the last row (the factor solve() uses): (L_nn L_nn^T)^-1, since L^-1 is lower triangular.
+  Block last_inverse_block() const {
+    const Block L = diagonal(factor_row(factor_rows() - 1));
+    const Block L_inv = L.template triangularView<Eigen::Lower>().solve(Block::Identity());
+    return L_inv.transpose() * L_inv;
+  }
+
+  /// The committed diagonal block S_ii.
+  Block diagonal_block(std::size_t i) const { return diagonal(matrix_.at(i)); }
+
+  /// The committed matrix as a dense symmetric matrix (tests, small problems).
+  Eigen::MatrixXd dense() const {
+    const Eigen::Index n = B * static_cast<Eigen::Index>(matrix_.size());
+    Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, n);
+    for (std::size_t i = 0; i < matrix_.size(); ++i) {
+      const Row& row = matrix_[i];
+      out.block(B * static_cast<Eigen::Index>(i), B * static_cast<Eigen::Index>(row.first), B, row.blocks.cols()) = row.blocks;
+    }
+    return out.selfadjointView<Eigen::Lower>();
+  }
+
+ private:
+  struct Row {
+    std::size_t first;  ///< first non-zero block column
+    Eigen::Matrix<double, B, Eigen::Dynamic> blocks;  ///< columns first .. i
+  };
+
+  static Block diagonal(const Row& row) { return row.blocks.template rightCols<B>(); }
+
+  std::size_t factor_rows() const { return factorized_ ? staged_count_ : factor_.size(); }
+  const Row& factor_row(std::size_t i) const {
+    return factorized_ && i >= first_changed_ ? staged_factor_[i - first_changed_] : factor_[i];
+  }
+
+  Row& staged_row(std::size_t i) {
+    if (staged_index_[i] < 0) {
+      staged_index_[i] = static_cast<long>(staged_rows_.size());
+      staged_rows_.push_back(matrix_[i]);
+      staged_ids_.push_back(i);
+    }
+    return staged_rows_[static_cast<std::size_t>(staged_index_[i])];
+  }
+
+  static void extend_left(Row& row, std::size_t first) {
+    const Eigen::Index extra = B * static_cast<Eigen::Index>(row.first - first);
+    Eigen::Matrix<double, B, Eigen::Dynamic> wider = Eigen::Matrix<double, B, Eigen::Dynamic>::Zero(B, extra + row.blocks.cols());
+    wider.rightCols(row.blocks.cols()) = row.blocks;
+    row.blocks = std::move(wider);
+    row.first = first;
+  }
+
+  const Row& matrix_row(std::size_t i) const {
+    return staged_index_[i] < 0 ? matrix_[i] : staged_rows_[static_cast<std::size_t>(staged_index_[i])];
+  }
+
+  /// The factor's rows e .. n - 1 of the staged matrix: chol(S[e:, e:] - L[e:, :e] L[e:, :e]^T).
+  std::vector<Row> factorized_trailing_rows() const {
+    const std::size_t e = first_changed_, n = staged_count_;
+    std::size_t reach = e;  // the oldest column a trailing row of the factor keeps below e
+    for (std::size_t i = e; i < n; ++i) reach = std::min(reach, matrix_row(i).first);
+    const Eigen::Index m = B * static_cast<Eigen::Index>(n - e), below = B * static_cast<Eigen::Index>(e - reach);
+    Eigen::MatrixXd T = Eigen::MatrixXd::Zero(m, m), kept = Eigen::MatrixXd::Zero(m, below);
+    for (std::size_t i = e; i < n; ++i) {
+      const Row& row = matrix_row(i);
+      const Eigen::Index at = B * static_cast<Eigen::Index>(i - e);
+      const std::size_t from = std::max(row.first, e);
+      T.block(at, B * static_cast<Eigen::Index>(from - e), B, B * static_cast<Eigen::Index>(i + 1 - from)) =
+          row.blocks.rightCols(B * static_cast<Eigen::Index>(i + 1 - from));
+      if (row.first < e) {
+        const Eigen::Index width = B * static_cast<Eigen::Index>(e - row.first);
+        kept.block(at, below - width, B, width) = factor_[i].blocks.leftCols(width);  // unchanged part of L
+      }
+    }
+    if (below > 0) T.selfadjointView<Eigen::Lower>().rankUpdate(kept, -1.0);
+    if (!T.allFinite()) throw numerical_error("information matrix has NaN or Inf entries (incremental Cholesky)");
+    const Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> llt(T);
+    if (llt.info() != Eigen::Success)
+      throw numerical_error("information matrix is not positive definite (incremental Cholesky from block row " + std::to_string(e) + ")");
+    const Eigen::MatrixXd L = llt.matrixL();
+    std::vector<Row> out;
+    out.reserve(n - e);
+    for (std::size_t i = e; i < n; ++i) {
+      const Row& row = matrix_row(i);
+      Row r{row.first, Eigen::Matrix<double, B, Eigen::Dynamic>(B, row.blocks.cols())};
+      const std::size_t from = std::max(row.first, e);
+      const Eigen::Index at = B * static_cast<Eigen::Index>(i - e), tail = B * static_cast<Eigen::Index>(i + 1 - from);
+      r.blocks.rightCols(tail) = L.block(at, B * static_cast<Eigen::Index>(from - e), B, tail);
+      if (row.first < e) r.blocks.leftCols(r.blocks.cols() - tail) = factor_[i].blocks.leftCols(r.blocks.cols() - tail);
+      out.push_back(std::move(r));
+    }
+    return out;
+  }
+
+  std::vector<Row> matrix_;  ///< S, committed
+  std::vector<Row> factor_;  ///< L of the committed S
+  std::vector<long> staged_index_;  ///< per row: its position in staged_rows_, -1 if not staged
+  std::vector<Row> staged_rows_;    ///< copies of the rows the staged changes touch, and new rows
+  std::vector<std::size_t> staged_ids_;  ///< the row of each staged copy
+  std::vector<Row> staged_factor_;  ///< rows first_changed_ .. of the staged matrix's factor
+  bool factorized_ = false;
+  std::size_t staged_count_ = 0;
+  std::size_t first_changed_ = 0;
+};
+
+}  // namespace sextant

@@ -1,0 +1,150 @@
+// GraphSLAM's online mode (GraphOptions::incremental): one Gauss-Newton step a frame on the
+// incrementally factorized reduced pose system.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+
+#include "sextant/backends/graph_slam.hpp"
+#include "sextant/eval/runner.hpp"
+#include "sextant/models/beacon_ship_2d.hpp"
+#include "sextant/models/point_in_robot_frame_2d.hpp"
+#include "sextant/models/se2_odometry.hpp"
+#include "sextant/sim/ship_2d.hpp"
+#include "support/batch_least_squares.hpp"
+
+namespace sextant {
+namespace {
+
+using Graph = GraphSlam<BeaconShip2D, BeaconOffset2D>;
+
+/// Largest difference between two graphs' pose and landmark means.
+template <class A, class B>
+double largest_difference(const A& a, const B& b) {
+  double worst = 0.0;
+  for (std::size_t k = 0; k < a.pose_means().size(); ++k)
+    worst = std::max(worst, (a.pose_means()[k] - b.pose_means()[k]).cwiseAbs().maxCoeff());
+  for (const auto& [id, mean] : a.landmark_means())
+    worst = std::max(worst, (mean - b.landmark(id).mean).cwiseAbs().maxCoeff());
+  return worst;
+}
+
+/// On a linear problem one Gauss-Newton step is the optimum, so after every frame the online
+/// estimate must be the batch optimum of the frames so far, and pose() the newest pose's marginal.
+TEST(GraphSlamOnline, EqualsTheBatchOptimumAfterEveryFrameOnALinearProblem) {
+  const auto steps = test::random_linear_steps(60, 6, 7);
+  Graph online{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.incremental = true}};
+  double worst_mean = 0.0, worst_cov = 0.0;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    online.predict(steps[k].control, steps[k].dt);
+    online.update(steps[k].observations);
+    if (k % 7 != 6 && k + 1 != steps.size()) continue;
+    Graph batch{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.max_iterations = 1}};
+    eval::run(batch, std::span(steps).first(k + 1));
+    batch.optimize();
+    worst_mean = std::max(worst_mean, largest_difference(online, batch));
+    worst_cov = std::max(worst_cov, (online.pose().cov - batch.trajectory().back().cov).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst_mean, 1e-9);
+  EXPECT_LT(worst_cov, 1e-9);
+}
+
+/// The ship is nonlinear (heading in the motion, range and bearing): the online estimate, relinearized
+/// only where a variable moved by more than a tenth of its conditional standard deviation, must end
+/// near the converged batch optimum. Margin: a quarter of each pose's marginal standard deviation,
+/// i.e. a difference the estimate's own uncertainty cannot tell apart.
+TEST(GraphSlamOnline, EndsAtTheBatchOptimumOnTheShip) {
+  const auto data = sim::simulate_ship_2d({.seed = 4, .num_steps = 400});
+  Graph online{data.motion, data.sensor, data.prior, {.incremental = true}};
+  Graph batch{data.motion, data.sensor, data.prior};
+  eval::run(online, data.steps);
+  eval::run(batch, data.steps);
+  ASSERT_TRUE(batch.optimize().converged);
+  const auto trajectory = batch.trajectory();
+  double worst = 0.0;
+  for (std::size_t k = 0; k < trajectory.size(); ++k) {
+    const Eigen::Vector2d sigma = trajectory[k].cov.diagonal().cwiseSqrt();
+    worst = std::max(worst, ((online.pose_means()[k] - trajectory[k].mean).cwiseAbs().cwiseQuotient(sigma)).maxCoeff());
+  }
+  std::printf("largest online - batch pose difference: %.4f marginal standard deviations\n", worst);
+  EXPECT_LT(worst, 0.25);
+  EXPECT_GT(online.last_online_step().poses, 400u);
+}
+
+/// A linear corridor: landmark j is in view from step 2 j to step 2 j + 5, so each frame's factors
+/// reach at most six poses back, however long the run.
+std::vector<Step<Eigen::Vector2d, Eigen::Vector2d>> corridor_steps(int num_steps) {
+  std::vector<Step<Eigen::Vector2d, Eigen::Vector2d>> steps;
+  for (int k = 0; k < num_steps; ++k) {
+    Step<Eigen::Vector2d, Eigen::Vector2d> step{Eigen::Vector2d(1.0, 0.1 * (k % 5)), 0.5, {}};
+    for (int j = std::max(0, (k - 5 + 1) / 2); 2 * j <= k; ++j)
+      step.observations.push_back({static_cast<LandmarkId>(j), Eigen::Vector2d(0.3 * (2 * j - k), 1.0 + 0.01 * k)});
+    steps.push_back(step);
+  }
+  return steps;
+}
+
+/// The incremental property: the reduced system is refactorized from the oldest pose that saw a
+/// landmark the new frame sees (or the previous pose, which the motion factor reaches), never from
+/// the first pose. Relinearization is off here (a moved pose reaches back further by design).
+TEST(GraphSlamOnline, RefactorizesOnlyFromTheOldestPoseTheNewFactorsReach) {
+  const auto steps = corridor_steps(120);
+  Graph online{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.incremental = true, .relinearize_threshold = 1e300}};
+  std::map<LandmarkId, std::size_t> first_seen;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    online.predict(steps[k].control, steps[k].dt);
+    online.update(steps[k].observations);
+    std::size_t oldest = k;  // the motion factor reaches pose k (the new one is k + 1)
+    for (const auto& observation : steps[k].observations)
+      oldest = std::min(oldest, first_seen.emplace(observation.landmark_id, k + 1).first->second);
+    if (k == 0) oldest = 0;  // the first step builds the system
+    EXPECT_EQ(online.last_online_step().first_row, oldest) << k;
+    EXPECT_GE(online.last_online_step().first_row + 8, k) << k;
+  }
+  Graph batch{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.max_iterations = 1}};
+  eval::run(batch, steps);
+  batch.optimize();
+  EXPECT_LT(largest_difference(online, batch), 1e-9);
+}
+
+/// optimize() in between, then more online frames: the online system is rebuilt at the optimum.
+TEST(GraphSlamOnline, ContinuesAfterABatchOptimization) {
+  const auto steps = test::random_linear_steps(40, 5, 9);
+  Graph online{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.incremental = true}};
+  Graph batch{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.max_iterations = 1}};
+  eval::run(online, std::span(steps).first(20));
+  online.optimize();
+  eval::run(online, std::span(steps).subspan(20));
+  eval::run(batch, steps);
+  batch.optimize();
+  EXPECT_LT(largest_difference(online, batch), 1e-9);
+}
+
+/// Removing landmarks (the bounded pool) keeps their information in S as linear factors: on a linear
+/// problem the online estimate still equals the batch optimum with the same removals, and a removed
+/// id seen again starts a new landmark in both.
+TEST(GraphSlamOnline, RemovedLandmarksKeepTheirInformation) {
+  const auto steps = test::random_linear_steps(40, 6, 12);
+  Graph online{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.incremental = true}};
+  Graph batch{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.max_iterations = 1}};
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    for (Graph* graph : {&online, &batch}) {
+      graph->predict(steps[k].control, steps[k].dt);
+      graph->update(steps[k].observations);
+      if (k % 9 == 8) graph->remove_landmark(graph->landmark_ids()[k % graph->num_landmarks()]);
+    }
+  }
+  batch.optimize();
+  EXPECT_EQ(online.num_landmarks(), batch.num_landmarks());
+  EXPECT_LT(largest_difference(online, batch), 1e-9);
+}
+
+TEST(GraphSlamOnline, RejectsANonPositiveRelinearizationThreshold) {
+  EXPECT_THROW((Graph{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior,
+                      {.incremental = true, .relinearize_threshold = 0.0}}),
+               invalid_input_error);
+}
+
+}  // namespace
+}  // namespace sextant
