@@ -210,7 +210,10 @@ class GraphSlam {
                                                            const OnlinePlan& plan) const;
   void restart_online() { online_ = Online{}; }
   LinearFactor marginal_factor(std::size_t slot) const;
-  LinearFactor online_marginal_factor(std::size_t slot) const;
+  template <class PoseAt>
+  LinearFactor eliminated_landmark_factor(const std::vector<typename Online::Term>& terms,
+                                          const Eigen::LLT<Eigen::Matrix<double, M, M>>& H, const Landmark& b_j,
+                                          PoseAt&& pose_at) const;
   void remove_landmark_online(std::size_t slot, std::optional<typename Online::PoseFactor> held);
 
   Motion motion_;

@@ -4,7 +4,6 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <chrono>
-#include <map>
 #include <string>
 #include <utility>
 
@@ -560,40 +559,51 @@ void GraphSlam<Motion, Sensor>::warm_start(std::span<const State> poses, const M
   touch();
 }
 
-/// Marginalization of a landmark (thesis Appendix C) at the current estimate: its measurement
-/// factors over (poses P, landmark j) become Lambda = A_PP - A_Pj A_jj^-1 A_jP, eta = b_P - A_Pj A_jj^-1 b_j.
+/// The linear factor a landmark leaves on its poses when it is eliminated (thesis Appendix C), from
+/// its measurement terms (Omega_pp, Omega_pj, b_p per measurement), H = Omega_jj factored and b_j:
+/// Lambda = A_PP - A_Pj H^-1 A_jP, eta = b_P - A_Pj H^-1 b_j over its poses in increasing order,
+/// linearized at pose_at(p).
+template <class Motion, class Sensor>
+template <class PoseAt>
+auto GraphSlam<Motion, Sensor>::eliminated_landmark_factor(const std::vector<typename Online::Term>& terms,
+                                                           const Eigen::LLT<Eigen::Matrix<double, M, M>>& H,
+                                                           const Landmark& b_j, PoseAt&& pose_at) const -> LinearFactor {
+  LinearFactor factor;
+  for (const auto& t : terms) factor.poses.push_back(t.pose);
+  std::sort(factor.poses.begin(), factor.poses.end());
+  factor.poses.erase(std::unique(factor.poses.begin(), factor.poses.end()), factor.poses.end());
+  const Eigen::Index n = X * static_cast<Eigen::Index>(factor.poses.size());
+  Eigen::MatrixXd A_PP = Eigen::MatrixXd::Zero(n, n), A_Pj = Eigen::MatrixXd::Zero(n, M);
+  Eigen::VectorXd b_P = Eigen::VectorXd::Zero(n);
+  for (const auto& t : terms) {
+    const Eigen::Index at = X * (std::lower_bound(factor.poses.begin(), factor.poses.end(), t.pose) - factor.poses.begin());
+    A_PP.template block<X, X>(at, at) += t.aa;
+    A_Pj.template middleRows<X>(at) += t.ab;
+    b_P.template segment<X>(at) += t.a;
+  }
+  for (std::size_t p : factor.poses) factor.linearization.push_back(pose_at(p));
+  factor.Lambda = symmetrized(A_PP - A_Pj * H.solve(A_Pj.transpose()));
+  factor.eta = b_P - A_Pj * H.solve(b_j);
+  return factor;
+}
+
+/// Marginalization of a landmark at the current estimate (every measurement, no robust weight).
 template <class Motion, class Sensor>
 auto GraphSlam<Motion, Sensor>::marginal_factor(std::size_t slot) const -> LinearFactor {
   const LandmarkId id = landmarks_.id_at(slot);
-  std::map<std::size_t, std::size_t> index;  // pose -> position in the factor
-  for (const auto& record : measurements_[slot]) index.emplace(record.pose, 0);
-  std::size_t next = 0;
-  for (auto& [pose, position] : index) position = next++;
-  const Eigen::Index n = X * static_cast<Eigen::Index>(index.size());
-  Eigen::MatrixXd A_PP = Eigen::MatrixXd::Zero(n, n), A_Pj = Eigen::MatrixXd::Zero(n, M);
+  std::vector<typename Online::Term> terms;
   Eigen::Matrix<double, M, M> A_jj = Eigen::Matrix<double, M, M>::Zero();
-  Eigen::VectorXd b_P = Eigen::VectorXd::Zero(n);
   Eigen::Matrix<double, M, 1> b_j = Eigen::Matrix<double, M, 1>::Zero();
   for (const auto& record : measurements_[slot]) {
     const auto prediction = sensor_.predict(poses_[record.pose], landmark_mean(slot));
     const GaussianNoise<Z> noise(prediction.Q, "measurement noise Q of landmark " + std::to_string(id));
     const auto info = noise.information(prediction.J_z_x, prediction.J_z_m, sensor_.residual(record.z, prediction.z));
-    const Eigen::Index at = X * static_cast<Eigen::Index>(index[record.pose]);
-    A_PP.template block<X, X>(at, at) += info.aa;
-    A_Pj.template middleRows<X>(at) += info.ab;
+    terms.push_back({record.pose, info.aa, info.ab, info.a});
     A_jj += info.bb;
-    b_P.template segment<X>(at) += info.a;
     b_j += info.b;
   }
   const auto llt = cholesky_or_throw(A_jj, "information of landmark " + std::to_string(id));
-  LinearFactor factor;
-  for (const auto& [pose, position] : index) {
-    factor.poses.push_back(pose);
-    factor.linearization.push_back(poses_[pose]);
-  }
-  factor.Lambda = symmetrized(A_PP - A_Pj * llt.solve(A_Pj.transpose()));
-  factor.eta = b_P - A_Pj * llt.solve(b_j);
-  return factor;
+  return eliminated_landmark_factor(terms, llt, b_j, [&](std::size_t p) -> const State& { return poses_[p]; });
 }
 
 /// In online mode the landmark's factor is its contribution to the reduced system at the
@@ -607,7 +617,8 @@ void GraphSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
   if (!online) {
     factor = marginal_factor(slot);
   } else if (!online_.landmarks[slot].terms.empty()) {
-    factor = online_marginal_factor(slot);
+    const auto& lin = online_.landmarks[slot];
+    factor = eliminated_landmark_factor(lin.terms, lin.H, lin.b, [&](std::size_t p) -> const State& { return online_.theta[p]; });
     held = marginal_information(*factor, [&](std::size_t p) -> const State& { return online_.theta[p]; });
     held->index = linear_factors_.size();
   }

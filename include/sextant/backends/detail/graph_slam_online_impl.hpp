@@ -212,31 +212,6 @@ void GraphSlam<Motion, Sensor>::commit_online_step(OnlinePlan& plan) {
   on.last_step = plan.summary;
 }
 
-/// The landmark's contribution to S as a linear factor on its poses at their linearization points
-/// (the same Schur complement, thesis Appendix C): Lambda = A_PP - A_Pj H^-1 A_jP, eta = b_P - A_Pj H^-1 b_j.
-template <class Motion, class Sensor>
-auto GraphSlam<Motion, Sensor>::online_marginal_factor(std::size_t slot) const -> LinearFactor {
-  const auto& lin = online_.landmarks[slot];
-  LinearFactor factor;
-  for (const auto& t : lin.terms)
-    if (std::find(factor.poses.begin(), factor.poses.end(), t.pose) == factor.poses.end()) factor.poses.push_back(t.pose);
-  std::sort(factor.poses.begin(), factor.poses.end());
-  const Eigen::Index n = X * static_cast<Eigen::Index>(factor.poses.size());
-  Eigen::MatrixXd A_PP = Eigen::MatrixXd::Zero(n, n), A_Pj = Eigen::MatrixXd::Zero(n, M);
-  Eigen::VectorXd b_P = Eigen::VectorXd::Zero(n);
-  for (const auto& t : lin.terms) {
-    const Eigen::Index at =
-        X * (std::lower_bound(factor.poses.begin(), factor.poses.end(), t.pose) - factor.poses.begin());
-    A_PP.template block<X, X>(at, at) += t.aa;
-    A_Pj.template middleRows<X>(at) += t.ab;
-    b_P.template segment<X>(at) += t.a;
-  }
-  for (std::size_t p : factor.poses) factor.linearization.push_back(online_.theta[p]);
-  factor.Lambda = symmetrized(A_PP - A_Pj * lin.H.solve(A_Pj.transpose()));
-  factor.eta = b_P - A_Pj * lin.H.solve(lin.b);
-  return factor;
-}
-
 /// Online bookkeeping of remove_landmark (before the store moves its last slot into `slot`): the
 /// landmark's contribution stays in S, now held by the newest linear factor (`held`, its blocks);
 /// the last slot's linearization and indices move into `slot`.

@@ -64,12 +64,12 @@ struct OnlineGraphState {
   Eigen::VectorXd delta_poses, delta_landmarks;  ///< the last step from theta
   OnlineStepSummary last_step;
 
-  /// S += sign Lambda, g += sign g over the factor's poses (lower blocks).
+  /// S += sign Lambda, g += sign g over the factor's poses (distinct; lower blocks).
   static void add(ProfileCholesky<X>& S, Eigen::VectorXd& g, const PoseFactor& f, double sign) {
     for (std::size_t i = 0; i < f.poses.size(); ++i) {
       g.template segment<X>(X * f.poses[i]) += sign * f.g.template segment<X>(X * i);
       for (std::size_t k = 0; k < f.poses.size(); ++k)
-        if (f.poses[i] >= f.poses[k] && (f.poses[i] != f.poses[k] || i == k))
+        if (f.poses[i] >= f.poses[k])
           S.add(f.poses[i], f.poses[k], sign * f.Lambda.template block<X, X>(X * i, X * k));
     }
   }
