@@ -114,6 +114,7 @@ struct RunnerConfig {
   /// [fastslam] gate_probability and [graph] robust_kernel say.
   double mrclam_gate_probability = 0.9999;
   RobustKernel mrclam_graph_kernel = RobustKernel::cauchy;
+  int mrclam_reacquire_after_landmarks = 3;  ///< [mrclam] reacquire_after_landmarks (docs/results/mrclam.md, stress cases)
   AssociationSettings association;
   double scene_quantile = 3.0;
 };
@@ -330,6 +331,9 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"mrclam", "gate_probability", "0.9999",
        "MRCLAM: Mahalanobis gate of EKF, SEIF and FastSLAM (real data has outliers; 0 = off); overrides their own",
        [](RunnerConfig& c, const std::string& v) { c.mrclam_gate_probability = parse_gate_probability(v); }},
+      {"mrclam", "reacquire_after_landmarks", "3",
+       "MRCLAM: the EKF re-acquires a pose lost beyond its covariance (with the gate on; 0 = never); overrides [ekf]",
+       [](RunnerConfig& c, const std::string& v) { c.mrclam_reacquire_after_landmarks = parse_integer<int>(v, 0, 1e6); }},
       {"mrclam", "graph_robust_kernel", "cauchy", "MRCLAM: GraphSLAM's robust kernel (none | huber | cauchy); overrides [graph]",
        [](RunnerConfig& c, const std::string& v) {
          c.mrclam_graph_kernel = parse_choice<RobustKernel>(
@@ -370,6 +374,16 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.ekf_observability_constraints = parse_auto_switch(v); }},
       {"ekf", "gate_probability", "0", "Mahalanobis gate: reject observations above this chi-square quantile; 0 = off",
        [](RunnerConfig& c, const std::string& v) { c.ekf.gate_probability = parse_gate_probability(v); }},
+      {"ekf", "reacquire_after_landmarks", "0",
+       "with the gate on: rejected sightings of this many distinct landmarks, none accepted since, start the test "
+       "of a lost pose (one offset explains them, dead reckoning could have drifted that far, the moved filter "
+       "explains what follows: core/pose_reacquisition.hpp); 0 = keep rejecting",
+       [](RunnerConfig& c, const std::string& v) { c.ekf.reacquisition.min_landmarks = parse_integer<int>(v, 0, 1e6); }},
+      {"ekf", "reacquire_drift_factor", "5",
+       "how many of its own standard deviations real odometry may drift beyond the motion model's dead reckoning",
+       [](RunnerConfig& c, const std::string& v) { c.ekf.reacquisition.drift_factor = positive(parse_number(v), v); }},
+      {"ekf", "reacquire_probation", "20", "sightings the moved copy and the filter are compared over",
+       [](RunnerConfig& c, const std::string& v) { c.ekf.reacquisition.probation = parse_integer<int>(v, 1, 1e6); }},
       {"ekf", "tangent_reset", "false",
        "re-read P in the tangent at the corrected pose (G P G^T; SE(3) and world-frame SE(2) only): the error-state "
        "filter's reset, off because it fights first-estimate Jacobians (docs/derivations/state_space_jacobians.md)",

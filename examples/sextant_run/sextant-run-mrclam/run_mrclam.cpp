@@ -81,9 +81,11 @@ std::pair<std::vector<BackendKind>, std::vector<BackendKind>> split_filters(cons
   return out;
 }
 
-/// The config with the [mrclam] gate and kernel set on the back-ends (RunnerConfig::mrclam_gate_probability).
+/// The config with the [mrclam] gate, re-acquisition and kernel set on the back-ends
+/// (RunnerConfig::mrclam_gate_probability); re-acquisition needs the gate.
 RunnerConfig with_mrclam_robustness(RunnerConfig c) {
   c.ekf.gate_probability = c.seif.gate_probability = c.fastslam.gate_probability = c.mrclam_gate_probability;
+  c.ekf.reacquisition.min_landmarks = c.mrclam_gate_probability > 0.0 ? c.mrclam_reacquire_after_landmarks : 0;
   c.graph.measurement_loss.kernel = c.mrclam_graph_kernel;
   return c;
 }

@@ -14,6 +14,7 @@
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/first_estimates.hpp"
 #include "sextant/core/observability_constraints.hpp"
+#include "sextant/core/pose_reacquisition.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/innovation_gate.hpp"
 #include "sextant/core/joint_marginal.hpp"
@@ -57,6 +58,13 @@ struct EkfOptions {
   /// motions unobservable, as they are. Needs a state space that names them
   /// (Space::world_motion_directions; the 12D camera does) and point landmarks.
   bool observability_constraints = false;
+  /// With the gate on: once it has rejected sightings of min_landmarks distinct landmarks and
+  /// accepted none since, whether the pose is lost and where (one offset explains them, dead
+  /// reckoning could have drifted that far, a copy moved there explains the next sightings better:
+  /// core/pose_reacquisition.hpp); min_landmarks = 0 (the default) keeps rejecting. Without it a
+  /// gated filter that comes back from a long gap beyond its own covariance never corrects again
+  /// (docs/results/mrclam.md, stress cases). Needs the gate: a min_landmarks > 0 without it throws.
+  ReacquisitionOptions reacquisition{};
 };
 
 /// EKF-SLAM: joint Gaussian over the robot state and a growing set of landmarks. Only the lower
@@ -91,6 +99,11 @@ class EkfSlam {
 
   /// Marginalizes a landmark out of the joint Gaussian. Throws unknown_landmark_error.
   void remove_landmark(LandmarkId id);
+
+  /// Moves the robot's mean by d (Space::plus) and adds d d^T to its covariance: the pose taken
+  /// as lost by d, with the uncertainty of not knowing whether it was (core/pose_reacquisition.hpp).
+  /// Throws invalid_input_error on a d that is not finite; the state is then unchanged.
+  void reacquire_pose(const Eigen::Matrix<double, X, 1>& d);
 
   PoseEstimate pose() const { return {x_, symmetric_diagonal_block<X>(cov_.view(), 0)}; }
   LandmarkEstimate<M> landmark(LandmarkId id) const { return landmark_at(landmarks_.slot(id)); }
@@ -152,6 +165,15 @@ class EkfSlam {
   Correction compute_correction(const std::vector<Linearized>& observations) const;
   Eigen::MatrixXd joseph_covariance(const std::vector<Linearized>& observations, const Eigen::MatrixXd& K) const;
   Plan plan(std::span<const ObservationType> known, std::span<const ObservationType> fresh, UpdateResult& result) const;
+  /// update() without re-acquisition: the EKF's correction and augmentation (eqs. 14-17).
+  UpdateResult correct_and_augment(std::span<const ObservationType> observations);
+  using Reacquisition = PoseReacquisition<Space, Sensor, State, X>;
+  /// After a committed update: the record of rejections, the probation, the switch to its candidate.
+  void follow_up_reacquisition(std::span<const ObservationType> observations, UpdateResult& result);
+  void start_probation(const Eigen::Matrix<double, X, 1>& d);
+  void end_probation_if_over(double candidate_log_likelihood, UpdateResult& result);
+  std::vector<typename Reacquisition::Sighting> rejected_sightings(std::span<const ObservationType> observations,
+                                                                   const UpdateResult& result) const;
   void commit(const Plan& plan);
   void apply(const Correction& correction);
   template <class Lower>
@@ -166,11 +188,14 @@ class EkfSlam {
   State propagated_;  ///< the robot state after the last prediction (observability constraints)
   LandmarkStore<M> landmarks_;  ///< ids, slots, means and first means (first_estimate_jacobians)
   GrowableSquareMatrix cov_;     ///< P; only its lower triangle is kept up to date
+  Reacquisition reacquisition_;  ///< the gate's rejections since the last accepted sighting
+  PoseProbation<EkfSlam> probation_;  ///< a copy moved to where the rejections say the pose is
 };
 
 }  // namespace sextant
 
 #include "sextant/backends/detail/ekf_slam_impl.hpp"
+#include "sextant/backends/detail/ekf_reacquisition_impl.hpp"
 
 // Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
 // are declared extern when the program links sextant::compiled.

@@ -19,6 +19,8 @@ EkfSlam<Motion, Sensor>::EkfSlam(Motion motion, Sensor sensor, const PoseEstimat
   require_constrainable<Space, Landmark>(options_.observability_constraints);
   cholesky_or_throw(prior.cov, "prior covariance");
   gate_ = InnovationGate(Z, options_.gate_probability);
+  if (options_.reacquisition.min_landmarks != 0)  // checks the options; needs the gate
+    reacquisition_ = Reacquisition(options_.reacquisition, options_.gate_probability);
   cov_.view() = symmetrized(prior.cov);
 }
 
@@ -36,10 +38,19 @@ void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   const Eigen::Matrix<double, X, X> P_xx = symmetrized(G * symmetric_diagonal_block<X>(P, 0) * G.transpose() + prediction.R);
   const Eigen::MatrixXd P_mx = P.bottomLeftCorner(rest, X) * G.transpose();
   if (!P_xx.allFinite() || !P_mx.allFinite()) throw numerical_error("EKF motion update overflowed (NaN or Inf)");
+  const auto drift = reacquisition_.drift_after(G, prediction.R);
   P.template topLeftCorner<X, X>() = P_xx;
   P.bottomLeftCorner(rest, X) = P_mx;
   x_ = prediction.x;
   propagated_ = prediction.x;
+  reacquisition_.set_drift(drift);
+  if (probation_.active()) {  // the candidate follows; one that cannot is dropped
+    try {
+      probation_.candidate().predict(u, dt);
+    } catch (const error&) {
+      probation_.drop();
+    }
+  }
 }
 
 
@@ -47,6 +58,13 @@ void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
 /// one correction per observation on a snapshot that is restored if any step throws.
 template <class Motion, class Sensor>
 UpdateResult EkfSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
+  UpdateResult result = correct_and_augment(observations);
+  follow_up_reacquisition(observations, result);
+  return result;
+}
+
+template <class Motion, class Sensor>
+UpdateResult EkfSlam<Motion, Sensor>::correct_and_augment(std::span<const ObservationType> observations) {
   require_valid_observations(observations);
   const auto [known, fresh] = split_known_and_new(landmarks_.pool(), observations);
   UpdateResult result;
@@ -97,6 +115,7 @@ void EkfSlam<Motion, Sensor>::gate(std::vector<Linearized>& observations, Update
   for (auto& obs : observations) {
     const Eigen::Matrix<double, Z, Z> S = symmetrized(jacobian_times(obs, cross_covariance(obs)) + obs.Q);
     const auto llt = cholesky_or_throw(S, "innovation covariance of landmark " + std::to_string(obs.id));
+    result.log_likelihood += gated_log_likelihood(gate_, llt, obs.residual);
     if (gate_.rejects(llt, obs.residual))
       result.rejected.push_back(obs.id);
     else
@@ -269,6 +288,13 @@ void EkfSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
   auto P = cov_.view();
   mirror_lower_to_upper(P);  // the move below reads whole rows and columns
   cov_.remove_block_by_moving_last(offset_of(removal.freed_slot), M);
+  if (probation_.active()) {  // the candidate follows; one that cannot is dropped
+    try {
+      probation_.candidate().remove_landmark(id);
+    } catch (const error&) {
+      probation_.drop();
+    }
+  }
 }
 
 template <class Motion, class Sensor>
