@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
 
 #include "sextant/core/error.hpp"
@@ -84,6 +85,20 @@ void require_well_conditioned(const Eigen::MatrixBase<Derived>& a, const std::st
 template <class Llt, class Derived>
 double mahalanobis_squared(const Llt& llt, const Eigen::MatrixBase<Derived>& r) {
   return llt.matrixL().solve(r).squaredNorm();
+}
+
+/// log N(nu; 0, S) = -(NIS + log det S + n log 2 pi) / 2 for an innovation whose NIS
+/// nu^T S^-1 nu is `nis`, given the Cholesky factor of S.
+template <class Llt>
+double log_gaussian_at_nis(const Llt& llt, double nis) {
+  const double log_det = 2.0 * llt.matrixLLT().diagonal().array().log().sum();
+  return -0.5 * (nis + log_det + static_cast<double>(llt.rows()) * std::log(2.0 * std::numbers::pi));
+}
+
+/// log N(nu; 0, S) given the Cholesky factor of S.
+template <class Llt, class Derived>
+double log_gaussian(const Llt& llt, const Eigen::MatrixBase<Derived>& nu) {
+  return log_gaussian_at_nis(llt, mahalanobis_squared(llt, nu));
 }
 
 }  // namespace sextant

@@ -6,8 +6,6 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
-#include <cmath>
-#include <numbers>
 #include <string>
 
 #include "sextant/core/chi_square.hpp"
@@ -43,13 +41,10 @@ class InnovationGate {
 
 /// log N(nu; 0, S) with the NIS clipped at the gate's threshold (a rejected observation counts as
 /// one on the gate's edge: the likelihood of an outlier model that is flat beyond the gate), from
-/// the Cholesky factor of S. With the gate off, the plain Gaussian log-likelihood.
-template <class Llt, class Residual>
-double gated_log_likelihood(const InnovationGate& gate, const Llt& llt, const Residual& nu) {
-  const double nis = mahalanobis_squared(llt, nu);
-  const double clipped = gate.on() ? std::min(nis, gate.threshold()) : nis;
-  const double log_det = 2.0 * llt.matrixLLT().diagonal().array().log().sum();
-  return -0.5 * (clipped + log_det + static_cast<double>(nu.size()) * std::log(2.0 * std::numbers::pi));
+/// the observation's NIS and the Cholesky factor of S. With the gate off, the plain Gaussian one.
+template <class Llt>
+double gated_log_likelihood(const InnovationGate& gate, const Llt& llt, double nis) {
+  return log_gaussian_at_nis(llt, gate.on() ? std::min(nis, gate.threshold()) : nis);
 }
 
 }  // namespace sextant

@@ -27,9 +27,8 @@
 ///    beside it on the next `probation` sightings; the copy replaces the filter only if its
 ///    predictive likelihood of them is higher (each sighting's N(nu; 0, S) with the NIS clipped at
 ///    the gate: an outlier model flat beyond it). The likelihood charges the copy for its wider
-///    covariance; counting the sightings each gate accepts favoured it (measured on seed 004's
-///    stereo data: 8.70 m became 10.64 m). A hypothesis bought with a consistent burst loses to
-///    the filter once real sightings come back.
+///    covariance, which counting the sightings each gate accepts would not. A hypothesis bought
+///    with a consistent burst loses to the filter once real sightings come back.
 ///
 /// This class answers questions 1 and 2 and keeps the record; the back-end runs the probation
 /// (PoseProbation below). D, the record and the probation are reset by any accepted sighting.
@@ -103,9 +102,7 @@ class PoseReacquisition {
   }
 
   bool on() const { return options_.min_landmarks > 0; }
-  const ReacquisitionOptions& options() const { return options_; }
   const std::vector<Sighting>& record() const { return record_; }
-  const Drift& drift() const { return drift_; }
 
   /// D after a motion step with transition G and noise R (pure; set_drift keeps it).
   Drift drift_after(const Drift& G, const Drift& R) const { return G * drift_ * G.transpose() + R; }
@@ -242,7 +239,6 @@ class PoseProbation {
 
   bool active() const { return candidate_ != nullptr; }
   Filter& candidate() { return *candidate_; }
-  const Filter* candidate_or_null() const { return candidate_.get(); }
 
   void start(std::unique_ptr<Filter> candidate) noexcept {
     candidate_ = std::move(candidate);

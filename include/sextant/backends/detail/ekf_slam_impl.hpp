@@ -54,8 +54,7 @@ void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
 }
 
 
-/// Batch mode: one joint correction, planned in full before anything changes. Sequential mode:
-/// one correction per observation on a snapshot that is restored if any step throws.
+/// The correction, then (when on) the re-acquisition's bookkeeping, which cannot throw.
 template <class Motion, class Sensor>
 UpdateResult EkfSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
   UpdateResult result = correct_and_augment(observations);
@@ -63,6 +62,8 @@ UpdateResult EkfSlam<Motion, Sensor>::update(std::span<const ObservationType> ob
   return result;
 }
 
+/// Batch mode: one joint correction, planned in full before anything changes. Sequential mode:
+/// one correction per observation on a snapshot that is restored if any step throws.
 template <class Motion, class Sensor>
 UpdateResult EkfSlam<Motion, Sensor>::correct_and_augment(std::span<const ObservationType> observations) {
   require_valid_observations(observations);
@@ -115,8 +116,9 @@ void EkfSlam<Motion, Sensor>::gate(std::vector<Linearized>& observations, Update
   for (auto& obs : observations) {
     const Eigen::Matrix<double, Z, Z> S = symmetrized(jacobian_times(obs, cross_covariance(obs)) + obs.Q);
     const auto llt = cholesky_or_throw(S, "innovation covariance of landmark " + std::to_string(obs.id));
-    result.log_likelihood += gated_log_likelihood(gate_, llt, obs.residual);
-    if (gate_.rejects(llt, obs.residual))
+    const double nis = mahalanobis_squared(llt, obs.residual);
+    result.log_likelihood += gated_log_likelihood(gate_, llt, nis);
+    if (gate_.rejects(nis))
       result.rejected.push_back(obs.id);
     else
       kept.push_back(std::move(obs));

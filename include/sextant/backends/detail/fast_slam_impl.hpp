@@ -13,15 +13,6 @@
 
 namespace sextant {
 
-namespace detail {
-/// log N(nu; 0, S) from the Cholesky factor of S.
-template <class Llt, class Vector>
-double log_gaussian(const Llt& llt, const Vector& nu) {
-  const double log_det = 2.0 * llt.matrixL().toDenseMatrix().diagonal().array().log().sum();
-  return -0.5 * (mahalanobis_squared(llt, nu) + log_det + nu.size() * std::log(2.0 * std::numbers::pi));
-}
-}  // namespace detail
-
 template <class Motion, class Sensor, template <class> class Map>
 FastSlam<Motion, Sensor, Map>::FastSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, FastSlamOptions options)
     : motion_(std::move(motion)),
@@ -153,7 +144,7 @@ void FastSlam<Motion, Sensor, Map>::apply_pending_motion_v1(Transaction& t) cons
 template <class Motion, class Sensor, template <class> class Map>
 template <class Llt>
 double FastSlam<Motion, Sensor, Map>::log_likelihood_at_gate_edge(const Llt& llt) const {
-  return detail::log_gaussian(llt, Eigen::Matrix<double, Z, 1>::Zero().eval()) - 0.5 * gate_.threshold();
+  return log_gaussian(llt, Eigen::Matrix<double, Z, 1>::Zero().eval()) - 0.5 * gate_.threshold();
 }
 
 /// One landmark EKF update with the particle's pose (eqs. 75-78, Joseph form); returns the log
@@ -175,7 +166,7 @@ auto FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::siz
   const Eigen::Matrix<double, M, M> I_KH = Eigen::Matrix<double, M, M>::Identity() - K * pred.J_z_m;
   LandmarkGaussian<M> updated{L.mean + K * nu, symmetrized(I_KH * L.cov * I_KH.transpose() + K * pred.Q * K.transpose()),
                               true, L.id};
-  const double log_likelihood = detail::log_gaussian(llt, nu);
+  const double log_likelihood = log_gaussian(llt, nu);
   if (!updated.mean.allFinite() || !updated.cov.allFinite() || !std::isfinite(log_likelihood))
     throw numerical_error("landmark update is not finite");
   map.set(index, std::move(updated));
@@ -218,7 +209,7 @@ double FastSlam<Motion, Sensor, Map>::fold_into_proposal(State& mean, PoseMatrix
   const Eigen::Matrix<double, X, Z> K = in.llt.solve(in.prediction.J_z_x * cov).transpose();
   mean = Space::plus(mean, K * in.nu);
   cov = symmetrized((PoseMatrix::Identity() - K * in.prediction.J_z_x) * cov);
-  return detail::log_gaussian(in.llt, in.nu);
+  return log_gaussian(in.llt, in.nu);
 }
 
 template <class Motion, class Sensor, template <class> class Map>
@@ -627,7 +618,7 @@ std::size_t FastSlam<Motion, Sensor, Map>::update_particle_unassociated(Particle
     particle.unassociated.push_back({init.m, symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose()), true, id});
     ++started;
     // A new landmark weighs as a measurement on the gate's edge (the p0 of Montemerlo et al.).
-    particle.log_weight += detail::log_gaussian(cholesky_or_throw(init.Q, "measurement noise"),
+    particle.log_weight += log_gaussian(cholesky_or_throw(init.Q, "measurement noise"),
                                                 Eigen::Matrix<double, Z, 1>::Zero().eval()) -
                            0.5 * options_.new_landmark_nis;
   }
