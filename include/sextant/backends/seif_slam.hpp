@@ -25,6 +25,7 @@
 #include "sextant/core/linearized_observation.hpp"
 #include "sextant/core/sparse_cholesky.hpp"
 #include "sextant/core/sparse_information.hpp"
+#include "sextant/core/square_workspace.hpp"
 #include "sextant/core/update_result.hpp"
 #include "sextant/core/versioned_cache.hpp"
 
@@ -210,7 +211,7 @@ class SeifSlam {
   void atomically(Step step);
   void move_landmark_mean(std::size_t slot, const Eigen::Matrix<double, M, 1>& dm);
   void require_finite_robot_and_active(const char* what) const;
-  void require_factorizable_robot_and_active(const char* what) const;
+  void require_factorizable_robot_and_active(const char* what);
   void recover_mean_exactly_in_transaction();
   /// This update is one of every exact_recovery_period-th (SeifOptions): its mean is recovered exactly.
   bool exact_recovery_due() const {
@@ -221,7 +222,9 @@ class SeifSlam {
   void recover_mean_by_coordinate_descent();
   Eigen::VectorXd recover_mean_of_active_block() { return recover_mean_of_block(active_queue_); }
   Eigen::VectorXd recover_mean_of_block(const std::vector<std::size_t>& slots);
-  Eigen::MatrixXd robot_and_landmarks_block(const std::vector<std::size_t>& slots) const;
+  void robot_and_landmarks_block(const std::vector<std::size_t>& slots, Eigen::Ref<Eigen::MatrixXd> D) const;
+  /// A predicate true for exactly the given slots, valid until the next call.
+  auto mark_slots(const std::vector<std::size_t>& slots);
   void update_active_queue(const std::vector<std::size_t>& observed_slots);
   /// ESEIF: the observations to relocalize the robot from, taken out of `observations`, when the
   /// update would leave more than max_active landmarks linked to the robot and some of them
@@ -235,7 +238,7 @@ class SeifSlam {
   /// The squared pivots of the Cholesky factor of S_xx when it sparsified.
   std::optional<Eigen::Matrix<double, X, 1>> sparsify();
   void require_factorizable_after_update(const std::optional<Eigen::VectorXd>& squared_pivots,
-                                         const std::optional<Eigen::Matrix<double, X, 1>>& robot_squared_pivots) const;
+                                         const std::optional<Eigen::Matrix<double, X, 1>>& robot_squared_pivots);
   std::shared_ptr<const Factor> factorization() const;
   /// What SeifOptions::estimate adds to the recovered means: Omega^-1 r (exact_mean) or nothing.
   std::shared_ptr<const Eigen::VectorXd> estimate_correction() const;
@@ -261,6 +264,10 @@ class SeifSlam {
   Undo* undo_ = nullptr;  ///< the open transaction's undo record
   VersionedCache<Factor> factor_;  ///< factorization of Omega at revision_ (thread-safe)
   VersionedCache<Eigen::VectorXd> correction_;  ///< Omega^-1 r at revision_ (exact_mean only)
+  SquareWorkspace block_workspace_;   ///< the dense robot-and-landmarks block of the step (scratch)
+  SquareWorkspace factor_workspace_;  ///< its Cholesky factor (scratch)
+  std::vector<std::uint64_t> slot_marks_;  ///< mark_slots' marks, per slot (scratch)
+  std::uint64_t last_mark_ = 0;
 };
 
 }  // namespace sextant

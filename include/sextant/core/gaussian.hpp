@@ -45,6 +45,16 @@ Eigen::LLT<typename Derived::PlainObject> cholesky_or_throw(const Eigen::MatrixB
   return llt;
 }
 
+/// cholesky_or_throw for a large dynamic block that is not needed afterwards: `a` is overwritten
+/// with its factor, which the returned decomposition refers to (no copy).
+inline Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> cholesky_in_place_or_throw(Eigen::Ref<Eigen::MatrixXd> a,
+                                                                          const std::string& what) {
+  if (!a.allFinite()) throw numerical_error(what + " has NaN or Inf entries");
+  Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(a);
+  if (llt.info() != Eigen::Success) throw numerical_error(what + " is not positive definite");
+  return llt;
+}
+
 /// Throws numerical_error naming `what` unless the symmetric matrix a is positive definite and
 /// provably not numerically singular. a is scaled to unit diagonal (Cholesky does not care about
 /// diagonal scaling, so the scaled condition is the one that counts) and factorized; its pivots
@@ -68,17 +78,25 @@ inline void require_well_conditioned_pivots(const Eigen::VectorXd& pivots, const
   }
 }
 
+/// require_well_conditioned on a matrix it may overwrite (with its scaled Cholesky factor), for a
+/// large block that is not needed afterwards: no copy.
 template <class Derived>
-void require_well_conditioned(const Eigen::MatrixBase<Derived>& a, const std::string& what) {
+void require_well_conditioned_in_place(Eigen::MatrixBase<Derived>& a, const std::string& what) {
   using Plain = typename Derived::PlainObject;
   if (!a.allFinite()) throw numerical_error(what + " has NaN or Inf entries");
-  const auto diagonal = a.diagonal();
-  if (!(diagonal.array() > 0.0).all()) throw numerical_error(what + " is not positive definite");
-  const Eigen::VectorXd scale = diagonal.array().rsqrt().matrix();
-  const Plain scaled = scale.asDiagonal() * a * scale.asDiagonal();
-  const Eigen::LLT<Plain> llt(scaled);
+  if (!(a.diagonal().array() > 0.0).all()) throw numerical_error(what + " is not positive definite");
+  const Eigen::VectorXd scale = a.diagonal().array().rsqrt().matrix();
+  a = scale.asDiagonal() * a * scale.asDiagonal();
+  Eigen::Ref<Plain> scaled(a.derived());
+  const Eigen::LLT<Eigen::Ref<Plain>> llt(scaled);  // factorizes in place
   if (llt.info() != Eigen::Success) throw numerical_error(what + " is not positive definite");
   require_well_conditioned_pivots(llt.matrixLLT().diagonal().array().square().matrix(), what);
+}
+
+template <class Derived>
+void require_well_conditioned(const Eigen::MatrixBase<Derived>& a, const std::string& what) {
+  typename Derived::PlainObject copy = a;
+  require_well_conditioned_in_place(copy, what);
 }
 
 /// Squared Mahalanobis distance r^T A^-1 r given the Cholesky factor of A.

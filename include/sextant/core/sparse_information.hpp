@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -81,6 +82,27 @@ class SparseInformation {
       journal_.links.push_back({i, j, inserted ? std::nullopt : std::optional<LandmarkBlock>(it->second)});
     if (!inserted) it->second += block;
     add_or_insert(links_[j], i, block.transpose());
+  }
+  /// Omega_{s_a, s_b} += change(a, b) and Omega_{s_b, s_a} += change(a, b)^T for every pair of
+  /// positions a < b of `slots` (distinct slots): add_to_link for all pairs, done one landmark's
+  /// links at a time, so that each map is probed while it is in cache (pair by pair, every second
+  /// write goes to a cold map). change(a, b) is called once from each side and must return the same
+  /// block both times.
+  template <class Change>
+  void add_to_links(std::span<const std::size_t> slots, Change change) {
+    for (std::size_t a = 0; a < slots.size(); ++a) {
+      const std::size_t i = slots[a];
+      Links& row = links_[i];
+      for (std::size_t b = 0; b < slots.size(); ++b) {
+        if (b == a) continue;
+        const std::size_t j = slots[b];
+        const LandmarkBlock block = a < b ? LandmarkBlock(change(a, b)) : LandmarkBlock(change(b, a).transpose());
+        auto [it, inserted] = row.try_emplace(j, block);
+        if (open_ && i < j && i < journal_.landmarks)  // the pair's record, made from its first slot's side
+          journal_.links.push_back({i, j, inserted ? std::nullopt : std::optional<LandmarkBlock>(it->second)});
+        if (!inserted) it->second += block;
+      }
+    }
   }
   /// Omega_{i, j} for any two slots (the diagonal block when i == j, zero when not linked).
   LandmarkBlock landmark_block(std::size_t i, std::size_t j) const {

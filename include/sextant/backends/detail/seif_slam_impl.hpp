@@ -15,6 +15,7 @@
 #include "sextant/core/factor_information.hpp"
 #include "sextant/core/landmark_init.hpp"
 #include "sextant/core/seif_sparsification.hpp"
+#include "sextant/core/symmetric_matrix.hpp"
 #include "sextant/core/validation.hpp"
 
 namespace sextant {
@@ -69,15 +70,17 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
     info_.robot() = symmetrized(A * Phi_xx);
     info_.robot_residual() = A * r_x;
     const Eigen::Matrix<double, X, 1> T_r_x = T * r_x;
+    std::vector<std::size_t> active(Phi_x.size());
+    std::vector<Eigen::Matrix<double, M, X>> Phi_T(Phi_x.size());  // Phi_xi^T T
     for (std::size_t a = 0; a < Phi_x.size(); ++a) {
       const auto& [i, Phi_xi] = Phi_x[a];
+      active[a] = i;
       info_.set_robot_link(i, A * Phi_xi);
-      const Eigen::Matrix<double, M, X> Phi_ix_T = Phi_xi.transpose() * T;
-      info_.diagonal(i) = symmetrized(info_.diagonal(i) - Phi_ix_T * Phi_xi);
+      Phi_T[a] = Phi_xi.transpose() * T;
+      info_.diagonal(i) = symmetrized(info_.diagonal(i) - Phi_T[a] * Phi_xi);
       info_.landmark_residual(i) -= Phi_xi.transpose() * T_r_x;
-      for (std::size_t b = a + 1; b < Phi_x.size(); ++b)
-        info_.add_to_link(i, Phi_x[b].first, -Phi_ix_T * Phi_x[b].second);
     }
+    info_.add_to_links(active, [&](std::size_t a, std::size_t b) { return -Phi_T[a] * Phi_x[b].second; });
     x_ = prediction.x;
     require_factorizable_robot_and_active("SEIF motion update");
   });
@@ -274,12 +277,13 @@ void SeifSlam<Motion, Sensor>::require_finite_robot_and_active(const char* what)
 /// The robot-and-active block is a principal block of Omega that every step touches: if it is
 /// numerically singular, so is Omega (require_well_conditioned), and pose() could not factorize it.
 template <class Motion, class Sensor>
-void SeifSlam<Motion, Sensor>::require_factorizable_robot_and_active(const char* what) const {
+void SeifSlam<Motion, Sensor>::require_factorizable_robot_and_active(const char* what) {
   require_finite_robot_and_active(what);
   std::vector<std::size_t> slots;
   for (const auto& [slot, block] : info_.robot_links()) slots.push_back(slot);
-  require_well_conditioned(robot_and_landmarks_block(slots),
-                           std::string(what) + ": the information of the robot and the active landmarks");
+  auto D = block_workspace_.view(X + M * static_cast<Eigen::Index>(slots.size()));
+  robot_and_landmarks_block(slots, D);
+  require_well_conditioned_in_place(D, std::string(what) + ": the information of the robot and the active landmarks");
 }
 
 /// The update's check of the block it leaves (require_factorizable_robot_and_active) without a
@@ -289,7 +293,7 @@ void SeifSlam<Motion, Sensor>::require_factorizable_robot_and_active(const char*
 template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::require_factorizable_after_update(
     const std::optional<Eigen::VectorXd>& squared_pivots,
-    const std::optional<Eigen::Matrix<double, X, 1>>& robot_squared_pivots) const {
+    const std::optional<Eigen::Matrix<double, X, 1>>& robot_squared_pivots) {
   constexpr const char* what = "SEIF update";
   if (!squared_pivots) return require_factorizable_robot_and_active(what);
   require_finite_robot_and_active(what);
@@ -313,25 +317,27 @@ std::optional<Eigen::VectorXd> SeifSlam<Motion, Sensor>::recover_mean_locally() 
   return squared_pivots;
 }
 
-/// Omega restricted to (robot, slots...) as a dense matrix.
+/// Omega restricted to (robot, slots...) as a dense matrix, written into D (X + M |slots| square):
+/// the links into the lower triangle, which is read down its columns, one landmark's links at a
+/// time, then mirrored in tiles, then the diagonal blocks whole.
 template <class Motion, class Sensor>
-Eigen::MatrixXd SeifSlam<Motion, Sensor>::robot_and_landmarks_block(const std::vector<std::size_t>& slots) const {
-  const Eigen::Index d = X + M * static_cast<Eigen::Index>(slots.size());
+void SeifSlam<Motion, Sensor>::robot_and_landmarks_block(const std::vector<std::size_t>& slots,
+                                                         Eigen::Ref<Eigen::MatrixXd> D) const {
   auto at = [](std::size_t k) { return X + M * static_cast<Eigen::Index>(k); };
-  Eigen::MatrixXd D(d, d);
-  D.template topLeftCorner<X, X>() = info_.robot();
   for (std::size_t a = 0; a < slots.size(); ++a) {
-    D.template block<X, M>(0, at(a)) = info_.robot_link(slots[a]);
     D.template block<M, X>(at(a), 0) = info_.robot_link(slots[a]).transpose();
-    D.template block<M, M>(at(a), at(a)) = info_.diagonal(slots[a]);
+    const auto& links = info_.links(slots[a]);
     for (std::size_t b = a + 1; b < slots.size(); ++b) {  // one look-up per pair
-      const auto link = info_.links(slots[a]).find(slots[b]);
-      const bool linked = link != info_.links(slots[a]).end();
-      D.template block<M, M>(at(a), at(b)) = linked ? link->second : Eigen::Matrix<double, M, M>::Zero();
-      D.template block<M, M>(at(b), at(a)) = D.template block<M, M>(at(a), at(b)).transpose();
+      const auto link = links.find(slots[b]);
+      if (link == links.end())
+        D.template block<M, M>(at(b), at(a)).setZero();
+      else
+        D.template block<M, M>(at(b), at(a)) = link->second.transpose();
     }
   }
-  return D;
+  mirror_lower_to_upper(D);
+  D.template topLeftCorner<X, X>() = info_.robot();
+  for (std::size_t a = 0; a < slots.size(); ++a) D.template block<M, M>(at(a), at(a)) = info_.diagonal(slots[a]);
 }
 
 /// Solves Omega_BB delta_B = r_B for B = robot + `slots` (in that order; the active landmarks in the
@@ -339,24 +345,37 @@ Eigen::MatrixXd SeifSlam<Motion, Sensor>::robot_and_landmarks_block(const std::v
 /// outside B: r_b -= Omega_bB delta_B. Returns the squared diagonal of the Cholesky factor of Omega_BB.
 template <class Motion, class Sensor>
 Eigen::VectorXd SeifSlam<Motion, Sensor>::recover_mean_of_block(const std::vector<std::size_t>& slots) {
-  const Eigen::MatrixXd D = robot_and_landmarks_block(slots);
-  Eigen::VectorXd r(D.rows());
+  const Eigen::Index d = X + M * static_cast<Eigen::Index>(slots.size());
+  auto D = block_workspace_.view(d);
+  robot_and_landmarks_block(slots, D);
+  Eigen::VectorXd r(d);
   r.template head<X>() = info_.robot_residual();
   for (std::size_t a = 0; a < slots.size(); ++a) r.template segment<M>(X + M * a) = info_.landmark_residual(slots[a]);
-  const auto llt = cholesky_or_throw(D, "information of the robot and the active landmarks");
+  auto factor = factor_workspace_.view(d);
+  factor = D;
+  const auto llt = cholesky_in_place_or_throw(factor, "information of the robot and the active landmarks");
   const Eigen::VectorXd delta = llt.solve(r);
   const Eigen::VectorXd r_after = r - D * delta;
   x_ = Space::plus(x_, delta.template head<X>());
   info_.robot_residual() = r_after.template head<X>();
-  std::unordered_set<std::size_t> in_block(slots.begin(), slots.end());
+  const auto in_block = mark_slots(slots);
   for (std::size_t a = 0; a < slots.size(); ++a) {
     const Eigen::Matrix<double, M, 1> dm = delta.template segment<M>(X + M * a);
     move_landmark_mean(slots[a], dm);
     info_.landmark_residual(slots[a]) = r_after.template segment<M>(X + M * a);
     for (const auto& [neighbour, block] : info_.links(slots[a]))
-      if (!in_block.contains(neighbour)) info_.landmark_residual(neighbour) -= block.transpose() * dm;
+      if (!in_block(neighbour)) info_.landmark_residual(neighbour) -= block.transpose() * dm;
   }
   return llt.matrixLLT().diagonal().array().square().matrix();
+}
+
+/// A test of membership in `slots` in O(1) without hashing: the slots get this call's mark.
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::mark_slots(const std::vector<std::size_t>& slots) {
+  slot_marks_.resize(landmarks_.size(), 0);
+  const std::uint64_t mark = ++last_mark_;
+  for (std::size_t slot : slots) slot_marks_[slot] = mark;
+  return [this, mark](std::size_t slot) { return slot_marks_[slot] == mark; };
 }
 
 /// Block coordinate descent on Omega delta = r over the robot and the active landmarks
@@ -454,12 +473,14 @@ void SeifSlam<Motion, Sensor>::marginalize_robot() {
   std::vector<Eigen::Matrix<double, X, M>> solved;  // Omega_xx^-1 Omega_xi
   for (const auto& [slot, block] : links) solved.push_back(robot.solve(block));
   const Eigen::Matrix<double, X, 1> solved_r = robot.solve(info_.robot_residual());
+  std::vector<std::size_t> slots;
   for (std::size_t a = 0; a < links.size(); ++a) {
     const auto& [i, L_i] = links[a];
+    slots.push_back(i);
     info_.diagonal(i) = symmetrized((info_.diagonal(i) - L_i.transpose() * solved[a]).eval());
     info_.landmark_residual(i) -= L_i.transpose() * solved_r;
-    for (std::size_t b = a + 1; b < links.size(); ++b) info_.add_to_link(i, links[b].first, -L_i.transpose() * solved[b]);
   }
+  info_.add_to_links(slots, [&](std::size_t a, std::size_t b) { return -links[a].second.transpose() * solved[b]; });
   for (const auto& [slot, block] : links) info_.remove_robot_link(slot);
   info_.robot().setZero();
   info_.robot_residual().setZero();
@@ -520,11 +541,10 @@ auto SeifSlam<Motion, Sensor>::sparsify() -> std::optional<Eigen::Matrix<double,
   const Eigen::Index n_R = M * static_cast<Eigen::Index>(R.size());
   const Eigen::Index n_dropped = n_R - M * static_cast<Eigen::Index>(kept);
   Eigen::MatrixXd D_xR(X, n_R), D_0R(n_dropped, n_R);  // robot rows; rows of the landmarks to deactivate
-  for (std::size_t b = 0; b < R.size(); ++b) {
-    D_xR.template middleCols<M>(M * b) = info_.robot_link(R[b]);
-    for (std::size_t a = kept; a < R.size(); ++a)
+  for (std::size_t b = 0; b < R.size(); ++b) D_xR.template middleCols<M>(M * b) = info_.robot_link(R[b]);
+  for (std::size_t a = kept; a < R.size(); ++a)  // row by row: one landmark's links at a time
+    for (std::size_t b = 0; b < R.size(); ++b)
       D_0R.template block<M, M>(M * (a - kept), M * b) = info_.landmark_block(R[a], R[b]);
-  }
   const auto change = seif_sparsification_change<X>(info_.robot(), D_xR, D_0R);
   info_.robot() = symmetrized(info_.robot() + change.robot);
   for (std::size_t a = 0; a < R.size(); ++a) {
@@ -534,9 +554,8 @@ auto SeifSlam<Motion, Sensor>::sparsify() -> std::optional<Eigen::Matrix<double,
     else
       info_.remove_robot_link(i);
     info_.diagonal(i) = symmetrized(info_.diagonal(i) + change.landmarks.template block<M, M>(M * a, M * a));
-    for (std::size_t b = a + 1; b < R.size(); ++b)
-      info_.add_to_link(i, R[b], change.landmarks.template block<M, M>(M * a, M * b));
   }
+  info_.add_to_links(R, [&](std::size_t a, std::size_t b) { return change.landmarks.template block<M, M>(M * a, M * b); });
   active_queue_.resize(kept);
   return change.robot_squared_pivots;
 }

@@ -1,0 +1,96 @@
+#include "sextant/core/sparse_information.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <random>
+#include <vector>
+
+#include "sextant/core/square_workspace.hpp"
+
+namespace sextant {
+namespace {
+
+using Info = SparseInformation<2, 2>;
+using Block = Info::LandmarkBlock;
+
+/// A form with `n` landmarks, random diagonal blocks and links between a third of the pairs.
+Info random_form(std::size_t n, std::mt19937& rng) {
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  auto random_block = [&] { return Block(Block::NullaryExpr([&] { return value(rng); })); };
+  Info info;
+  for (std::size_t i = 0; i < n; ++i) {
+    info.append_landmark();
+    info.diagonal(i) = Block::Identity() * 10.0;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j)
+      if (rng() % 3 == 0) info.add_to_link(i, j, random_block());
+  return info;
+}
+
+/// Every change of a set of pairs, as the callers pass it: block (a, b) for positions a < b.
+Eigen::MatrixXd random_changes(std::size_t count, std::mt19937& rng) {
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  return Eigen::MatrixXd::NullaryExpr(2 * static_cast<Eigen::Index>(count), 2 * static_cast<Eigen::Index>(count),
+                                      [&] { return value(rng); });
+}
+
+TEST(SparseInformation, AddToLinksIsAddToLinkPairByPairBitForBit) {
+  // add_to_links writes one landmark's links at a time; the result must be what add_to_link gives
+  // pair by pair, to the bit, for slots in any order (SEIF passes its queue order) and for pairs
+  // that are linked already and pairs that are not.
+  std::mt19937 rng(11);
+  const Info start = random_form(30, rng);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<std::size_t> slots(30);
+    for (std::size_t i = 0; i < slots.size(); ++i) slots[i] = i;
+    std::shuffle(slots.begin(), slots.end(), rng);
+    slots.resize(5 + rng() % 20);
+    const Eigen::MatrixXd changes = random_changes(slots.size(), rng);
+    auto change = [&](std::size_t a, std::size_t b) { return Block(changes.block<2, 2>(2 * a, 2 * b)); };
+    Info by_rows = start, by_pairs = start;
+    by_rows.add_to_links(slots, change);
+    for (std::size_t a = 0; a < slots.size(); ++a)
+      for (std::size_t b = a + 1; b < slots.size(); ++b) by_pairs.add_to_link(slots[a], slots[b], change(a, b));
+    EXPECT_EQ(Eigen::MatrixXd(by_rows.to_sparse()), Eigen::MatrixXd(by_pairs.to_sparse())) << "trial " << trial;
+  }
+}
+
+TEST(SparseInformation, AddToLinksIsUndoneByRollback) {
+  // Inside a transaction, with a landmark appended in it (its links are dropped with it) and pairs
+  // that were not linked before (their links are erased again).
+  std::mt19937 rng(12);
+  Info info = random_form(15, rng);
+  const Eigen::MatrixXd before = info.to_sparse();
+  std::vector<std::size_t> link_counts;
+  for (std::size_t i = 0; i < info.num_landmarks(); ++i) link_counts.push_back(info.links(i).size());
+  info.begin_transaction();
+  const std::size_t added = info.append_landmark();
+  const std::vector<std::size_t> slots{7, added, 2, 11, 0, 14};
+  const Eigen::MatrixXd changes = random_changes(slots.size(), rng);
+  info.add_to_links(slots, [&](std::size_t a, std::size_t b) { return Block(changes.block<2, 2>(2 * a, 2 * b)); });
+  EXPECT_NE(info.links(added).size(), 0u);
+  info.rollback();
+  EXPECT_EQ(Eigen::MatrixXd(info.to_sparse()), before);
+  for (std::size_t i = 0; i < info.num_landmarks(); ++i) EXPECT_EQ(info.links(i).size(), link_counts[i]) << "slot " << i;
+}
+
+TEST(SquareWorkspace, HandsOutViewsOfOneBufferAndCopiesEmpty) {
+  SquareWorkspace workspace;
+  auto small = workspace.view(10);
+  EXPECT_EQ(small.rows(), 10);
+  EXPECT_EQ(small.cols(), 10);
+  const std::size_t bytes = workspace.memory_bytes();
+  EXPECT_EQ(bytes, 100 * sizeof(double));
+  workspace.view(8);
+  EXPECT_EQ(workspace.memory_bytes(), bytes);  // no reallocation for a smaller block
+  workspace.view(11);
+  EXPECT_EQ(workspace.memory_bytes(), 12 * 12 * sizeof(double));  // grows by a quarter at least
+  const SquareWorkspace copy = workspace;
+  EXPECT_EQ(copy.memory_bytes(), 0u);  // scratch is not state
+}
+
+}  // namespace
+}  // namespace sextant
