@@ -77,6 +77,29 @@ TEST(SparseInformation, AddToLinksIsUndoneByRollback) {
   for (std::size_t i = 0; i < info.num_landmarks(); ++i) EXPECT_EQ(info.links(i).size(), link_counts[i]) << "slot " << i;
 }
 
+TEST(SparseInformation, ARowOfBlocksIsLandmarkBlockForEachSlot) {
+  // Long enough that the look-ups are prefetched ahead (8 and 16 look-ups), with the row's own slot
+  // (its diagonal block), linked and unlinked slots; and prefetching a map, empty or not, reads
+  // nothing outside it (the sanitizer build runs this test).
+  std::mt19937 rng(13);
+  const Info info = random_form(40, rng);
+  std::vector<std::size_t> slots(40);
+  for (std::size_t i = 0; i < slots.size(); ++i) slots[i] = i;
+  std::shuffle(slots.begin(), slots.end(), rng);
+  for (const std::size_t row : {std::size_t{0}, std::size_t{17}, std::size_t{39}}) {
+    std::size_t visited = 0;
+    info.for_each_block_in_row(row, slots, [&](std::size_t b, const Block& block) {
+      EXPECT_EQ(b, visited++);
+      EXPECT_EQ(block, info.landmark_block(row, slots[b])) << "row " << row << ", slot " << slots[b];
+    });
+    EXPECT_EQ(visited, slots.size());
+  }
+  const DenseSlotMap<Block> empty;
+  empty.prefetch_position(3);
+  empty.prefetch_entry(3);
+  for (std::size_t key = 0; key < 100; ++key) info.links(0).prefetch_entry(key);
+}
+
 TEST(SquareWorkspace, HandsOutViewsOfOneBufferAndCopiesEmpty) {
   SquareWorkspace workspace;
   auto small = workspace.view(10);

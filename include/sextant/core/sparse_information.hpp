@@ -88,12 +88,15 @@ class SparseInformation {
   /// links at a time, so that each map is probed while it is in cache (pair by pair, every second
   /// write goes to a cold map). change(a, b) is called once from each side and must return the same
   /// block both times.
+  static constexpr std::size_t kPrefetchAhead = 8;  ///< look-ups between a prefetch and its use
   template <class Change>
   void add_to_links(std::span<const std::size_t> slots, Change change) {
     for (std::size_t a = 0; a < slots.size(); ++a) {
       const std::size_t i = slots[a];
       Links& row = links_[i];
       for (std::size_t b = 0; b < slots.size(); ++b) {
+        if (b + 2 * kPrefetchAhead < slots.size()) row.prefetch_position(slots[b + 2 * kPrefetchAhead]);
+        if (b + kPrefetchAhead < slots.size()) row.prefetch_entry(slots[b + kPrefetchAhead]);
         if (b == a) continue;
         const std::size_t j = slots[b];
         const LandmarkBlock block = a < b ? LandmarkBlock(change(a, b)) : LandmarkBlock(change(b, a).transpose());
@@ -102,6 +105,23 @@ class SparseInformation {
           journal_.links.push_back({i, j, inserted ? std::nullopt : std::optional<LandmarkBlock>(it->second)});
         if (!inserted) it->second += block;
       }
+    }
+  }
+  /// out(b, Omega_{i, slots[b]}) for every b in order (the diagonal block where slots[b] == i, zero
+  /// where not linked): landmark_block along one row, its look-ups prefetched ahead.
+  template <class Out>
+  void for_each_block_in_row(std::size_t i, std::span<const std::size_t> slots, Out out) const {
+    const Links& row = links_[i];
+    for (std::size_t b = 0; b < slots.size(); ++b) {
+      if (b + 2 * kPrefetchAhead < slots.size()) row.prefetch_position(slots[b + 2 * kPrefetchAhead]);
+      if (b + kPrefetchAhead < slots.size()) row.prefetch_entry(slots[b + kPrefetchAhead]);
+      const std::size_t j = slots[b];
+      if (j == i) {
+        out(b, diagonal_[i]);
+        continue;
+      }
+      const auto it = row.find(j);
+      out(b, it == row.end() ? LandmarkBlock::Zero().eval() : it->second);
     }
   }
   /// Omega_{i, j} for any two slots (the diagonal block when i == j, zero when not linked).

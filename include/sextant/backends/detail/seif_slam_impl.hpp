@@ -326,14 +326,10 @@ void SeifSlam<Motion, Sensor>::robot_and_landmarks_block(const std::vector<std::
   auto at = [](std::size_t k) { return X + M * static_cast<Eigen::Index>(k); };
   for (std::size_t a = 0; a < slots.size(); ++a) {
     D.template block<M, X>(at(a), 0) = info_.robot_link(slots[a]).transpose();
-    const auto& links = info_.links(slots[a]);
-    for (std::size_t b = a + 1; b < slots.size(); ++b) {  // one look-up per pair
-      const auto link = links.find(slots[b]);
-      if (link == links.end())
-        D.template block<M, M>(at(b), at(a)).setZero();
-      else
-        D.template block<M, M>(at(b), at(a)) = link->second.transpose();
-    }
+    const auto below = std::span(slots).subspan(a + 1);  // one look-up per pair
+    info_.for_each_block_in_row(slots[a], below, [&](std::size_t b, const Eigen::Matrix<double, M, M>& block) {
+      D.template block<M, M>(at(a + 1 + b), at(a)) = block.transpose();
+    });
   }
   mirror_lower_to_upper(D);
   D.template topLeftCorner<X, X>() = info_.robot();
@@ -543,8 +539,9 @@ auto SeifSlam<Motion, Sensor>::sparsify() -> std::optional<Eigen::Matrix<double,
   Eigen::MatrixXd D_xR(X, n_R), D_0R(n_dropped, n_R);  // robot rows; rows of the landmarks to deactivate
   for (std::size_t b = 0; b < R.size(); ++b) D_xR.template middleCols<M>(M * b) = info_.robot_link(R[b]);
   for (std::size_t a = kept; a < R.size(); ++a)  // row by row: one landmark's links at a time
-    for (std::size_t b = 0; b < R.size(); ++b)
-      D_0R.template block<M, M>(M * (a - kept), M * b) = info_.landmark_block(R[a], R[b]);
+    info_.for_each_block_in_row(R[a], R, [&](std::size_t b, const Eigen::Matrix<double, M, M>& block) {
+      D_0R.template block<M, M>(M * (a - kept), M * b) = block;
+    });
   const auto change = seif_sparsification_change<X>(info_.robot(), D_xR, D_0R);
   info_.robot() = symmetrized(info_.robot() + change.robot);
   for (std::size_t a = 0; a < R.size(); ++a) {
