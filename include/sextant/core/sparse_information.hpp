@@ -88,15 +88,13 @@ class SparseInformation {
   /// links at a time, so that each map is probed while it is in cache (pair by pair, every second
   /// write goes to a cold map). change(a, b) is called once from each side and must return the same
   /// block both times.
-  static constexpr std::size_t kPrefetchAhead = 8;  ///< look-ups between a prefetch and its use
   template <class Change>
   void add_to_links(std::span<const std::size_t> slots, Change change) {
     for (std::size_t a = 0; a < slots.size(); ++a) {
       const std::size_t i = slots[a];
       Links& row = links_[i];
       for (std::size_t b = 0; b < slots.size(); ++b) {
-        if (b + 2 * kPrefetchAhead < slots.size()) row.prefetch_position(slots[b + 2 * kPrefetchAhead]);
-        if (b + kPrefetchAhead < slots.size()) row.prefetch_entry(slots[b + kPrefetchAhead]);
+        prefetch_ahead(row, slots, b);
         if (b == a) continue;
         const std::size_t j = slots[b];
         const LandmarkBlock block = a < b ? LandmarkBlock(change(a, b)) : LandmarkBlock(change(b, a).transpose());
@@ -113,8 +111,7 @@ class SparseInformation {
   void for_each_block_in_row(std::size_t i, std::span<const std::size_t> slots, Out out) const {
     const Links& row = links_[i];
     for (std::size_t b = 0; b < slots.size(); ++b) {
-      if (b + 2 * kPrefetchAhead < slots.size()) row.prefetch_position(slots[b + 2 * kPrefetchAhead]);
-      if (b + kPrefetchAhead < slots.size()) row.prefetch_entry(slots[b + kPrefetchAhead]);
+      prefetch_ahead(row, slots, b);
       const std::size_t j = slots[b];
       if (j == i) {
         out(b, diagonal_[i]);
@@ -184,6 +181,13 @@ class SparseInformation {
   std::size_t memory_bytes() const;
 
  private:
+  static constexpr std::size_t kPrefetchAhead = 8;  ///< look-ups between a prefetch and its use
+  /// Before the look-up of slots[b] in `row`: the index position of the key 2 kPrefetchAhead
+  /// look-ups ahead, and the entry of the one kPrefetchAhead ahead (whose position is loaded by now).
+  static void prefetch_ahead(const Links& row, std::span<const std::size_t> slots, std::size_t b) {
+    if (b + 2 * kPrefetchAhead < slots.size()) row.prefetch_position(slots[b + 2 * kPrefetchAhead]);
+    if (b + kPrefetchAhead < slots.size()) row.prefetch_entry(slots[b + kPrefetchAhead]);
+  }
   template <class Block, class Map>
   static void add_or_insert(Map& map, std::size_t key, const Block& block) {
     auto [it, inserted] = map.try_emplace(key, block);
