@@ -4,9 +4,11 @@ set -euo pipefail
 # libmrpt-dev: rawlogs, 3D scenes, CConfigFile; mrpt-common: the kf-slam demo rawlogs; libzip-dev: .npz files;
 # libopencv-dev: the visual front-end (sextant::vision); python3-matplotlib: --plots; clang: run.sh's
 # compiler (docs/build_times.md), g++ the benchmarks' and the thread-sanitizer build's; libopenmpi-dev,
-# openmpi-bin: mpirun over a Monte Carlo study's seeds (docs/monte_carlo_clusters.md)
+# openmpi-bin: mpirun over a Monte Carlo study's seeds (docs/monte_carlo_clusters.md); libopenblas-pthread-dev:
+# SEIF's large dense Cholesky (core/dense_cholesky.hpp) and the BLAS under CHOLMOD and Ceres (not the serial
+# OpenBLAS: Debian builds it without locking, and two threads calling it at once get wrong results)
 packages=(cmake make g++ clang libeigen3-dev libboost-dev libgtest-dev libbenchmark-dev libcli11-dev libsuitesparse-dev libceres-dev
-          libmrpt-dev mrpt-common libzip-dev libopencv-dev python3-matplotlib
+          libopenblas-pthread-dev libmrpt-dev mrpt-common libzip-dev libopencv-dev python3-matplotlib
           libopenmpi-dev openmpi-bin "$@")  # "$@": extra packages to install
 missing=()
 for p in "${packages[@]}"; do

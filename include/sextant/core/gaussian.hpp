@@ -8,6 +8,7 @@
 #include <numbers>
 #include <string>
 
+#include "sextant/core/dense_cholesky.hpp"
 #include "sextant/core/error.hpp"
 #include "sextant/core/observation.hpp"
 
@@ -46,13 +47,11 @@ Eigen::LLT<typename Derived::PlainObject> cholesky_or_throw(const Eigen::MatrixB
 }
 
 /// cholesky_or_throw for a large dynamic block that is not needed afterwards: `a` is overwritten
-/// with its factor, which the returned decomposition refers to (no copy).
-inline Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> cholesky_in_place_or_throw(Eigen::Ref<Eigen::MatrixXd> a,
-                                                                          const std::string& what) {
+/// with its factor (core/dense_cholesky.hpp), which the returned view refers to (no copy).
+inline LowerCholeskyFactor cholesky_in_place_or_throw(Eigen::Ref<Eigen::MatrixXd> a, const std::string& what) {
   if (!a.allFinite()) throw numerical_error(what + " has NaN or Inf entries");
-  Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(a);
-  if (llt.info() != Eigen::Success) throw numerical_error(what + " is not positive definite");
-  return llt;
+  if (!factorize_lower_in_place(a)) throw numerical_error(what + " is not positive definite");
+  return LowerCholeskyFactor(a);
 }
 
 /// Throws numerical_error naming `what` unless the symmetric matrix a is positive definite and
@@ -87,10 +86,15 @@ void require_well_conditioned_in_place(Eigen::MatrixBase<Derived>& a, const std:
   if (!(a.diagonal().array() > 0.0).all()) throw numerical_error(what + " is not positive definite");
   const Eigen::VectorXd scale = a.diagonal().array().rsqrt().matrix();
   a = scale.asDiagonal() * a * scale.asDiagonal();
-  Eigen::Ref<Plain> scaled(a.derived());
-  const Eigen::LLT<Eigen::Ref<Plain>> llt(scaled);  // factorizes in place
-  if (llt.info() != Eigen::Success) throw numerical_error(what + " is not positive definite");
-  require_well_conditioned_pivots(llt.matrixLLT().diagonal().array().square().matrix(), what);
+  bool positive_definite = false;
+  if constexpr (Derived::RowsAtCompileTime == Eigen::Dynamic) {
+    positive_definite = factorize_lower_in_place(a.derived());
+  } else {
+    Eigen::Ref<Plain> scaled(a.derived());
+    positive_definite = Eigen::LLT<Eigen::Ref<Plain>>(scaled).info() == Eigen::Success;  // factorizes in place
+  }
+  if (!positive_definite) throw numerical_error(what + " is not positive definite");
+  require_well_conditioned_pivots(a.diagonal().array().square().matrix(), what);
 }
 
 template <class Derived>

@@ -349,8 +349,8 @@ Eigen::VectorXd SeifSlam<Motion, Sensor>::recover_mean_of_block(const std::vecto
   for (std::size_t a = 0; a < slots.size(); ++a) r.template segment<M>(X + M * a) = info_.landmark_residual(slots[a]);
   auto factor = factor_workspace_.view(d);
   factor = D;
-  const auto llt = cholesky_in_place_or_throw(factor, "information of the robot and the active landmarks");
-  const Eigen::VectorXd delta = llt.solve(r);
+  const auto L = cholesky_in_place_or_throw(factor, "information of the robot and the active landmarks");
+  const Eigen::VectorXd delta = L.solve(r);
   const Eigen::VectorXd r_after = r - D * delta;
   x_ = Space::plus(x_, delta.template head<X>());
   info_.robot_residual() = r_after.template head<X>();
@@ -362,7 +362,7 @@ Eigen::VectorXd SeifSlam<Motion, Sensor>::recover_mean_of_block(const std::vecto
     for (const auto& [neighbour, block] : info_.links(slots[a]))
       if (!in_block(neighbour)) info_.landmark_residual(neighbour) -= block.transpose() * dm;
   }
-  return llt.matrixLLT().diagonal().array().square().matrix();
+  return L.squared_pivots();
 }
 
 /// A test of membership in `slots` in O(1) without hashing: the slots get this call's mark.

@@ -1,0 +1,61 @@
+#pragma once
+/// \file The dense Cholesky factorization of the large blocks, in place: SEIF's robot-and-active
+/// block (about 790 dimensions in mean recovery at the thesis's scale, 462 after sparsification).
+/// With `sextant::lapack` linked (OpenBLAS, which picks the CPU's vector instructions when it is
+/// loaded) blocks of kLapackMinDimension and more go to LAPACK's dpotrf: 1.4x Eigen's LLT at 64
+/// dimensions, 2x from 256 on, for a build without -march flags (docs/benchmarks.md). Otherwise,
+/// and below that size, Eigen's blocked LLT.
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <cstddef>
+#include <limits>
+
+#ifdef SEXTANT_HAS_LAPACK
+/// LAPACK's dpotrf with gfortran's calling convention (the length of `uplo` passed last).
+extern "C" void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info,
+                        std::size_t uplo_length);
+#endif
+
+namespace sextant {
+
+/// The smallest block handed to LAPACK: below it the call costs what it saves (measured).
+inline constexpr Eigen::Index kLapackMinDimension = 64;
+
+/// Overwrites the lower triangle of the symmetric matrix a with its Cholesky factor L, a = L L^T;
+/// the strict upper triangle is not touched. Returns false, with the lower triangle holding a
+/// partial factor, when a is not positive definite. a must be finite.
+inline bool factorize_lower_in_place(Eigen::Ref<Eigen::MatrixXd> a) {
+#ifdef SEXTANT_HAS_LAPACK
+  constexpr Eigen::Index int_max = std::numeric_limits<int>::max();
+  if (a.rows() >= kLapackMinDimension && a.outerStride() <= int_max) {
+    const char lower = 'L';
+    const int n = static_cast<int>(a.rows()), lda = static_cast<int>(a.outerStride());
+    int info = 0;
+    dpotrf_(&lower, &n, a.data(), &lda, &info, 1);
+    return info == 0;
+  }
+#endif
+  return Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>>(a).info() == Eigen::Success;
+}
+
+/// The factor that factorize_lower_in_place left in the lower triangle of a matrix: solves with
+/// L L^T and its squared pivots L_ii^2. Refers to that matrix, which must outlive it.
+class LowerCholeskyFactor {
+ public:
+  explicit LowerCholeskyFactor(Eigen::Ref<const Eigen::MatrixXd> factor) : factor_(factor) {}
+
+  /// (L L^T)^-1 b: forward substitution with L, then back substitution with L^T.
+  Eigen::VectorXd solve(const Eigen::VectorXd& b) const {
+    Eigen::VectorXd x = factor_.triangularView<Eigen::Lower>().solve(b);
+    factor_.triangularView<Eigen::Lower>().transpose().solveInPlace(x);
+    return x;
+  }
+
+  Eigen::VectorXd squared_pivots() const { return factor_.diagonal().array().square().matrix(); }
+
+ private:
+  Eigen::Ref<const Eigen::MatrixXd> factor_;
+};
+
+}  // namespace sextant

@@ -1,0 +1,96 @@
+#include "sextant/core/dense_cholesky.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <limits>
+#include <random>
+
+#include "sextant/core/error.hpp"
+#include "sextant/core/gaussian.hpp"
+
+namespace sextant {
+namespace {
+
+/// A random symmetric positive definite n x n matrix with condition number about 1e4: Q diag Q^T.
+Eigen::MatrixXd random_spd(Eigen::Index n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd g(n, n);
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index i = 0; i < n; ++i) g(i, j) = normal(rng);
+  const Eigen::MatrixXd q = Eigen::HouseholderQR<Eigen::MatrixXd>(g).householderQ();
+  const Eigen::VectorXd eigenvalues = Eigen::VectorXd::LinSpaced(n, 1e-4, 1.0);
+  return q * eigenvalues.asDiagonal() * q.transpose();
+}
+
+/// Sizes on both sides of kLapackMinDimension: with sextant::lapack linked both paths run.
+const Eigen::Index kSizes[] = {1, 8, kLapackMinDimension - 1, kLapackMinDimension, 200};
+
+// Backward stability: L L^T = A + E with |E| <= c n u |A| (Higham, Thm 10.3); 100 n u is generous.
+double factor_tolerance(Eigen::Index n) { return 100.0 * static_cast<double>(n) * std::numeric_limits<double>::epsilon(); }
+
+TEST(DenseCholesky, FactorReproducesTheMatrixAndLeavesTheStrictUpperTriangleAlone) {
+  for (const Eigen::Index n : kSizes) {
+    const Eigen::MatrixXd a = random_spd(n, static_cast<unsigned>(n));
+    Eigen::MatrixXd work = a;
+    work.triangularView<Eigen::StrictlyUpper>().setConstant(7.0);  // must survive
+    ASSERT_TRUE(factorize_lower_in_place(work)) << "n = " << n;
+    const Eigen::MatrixXd L = work.triangularView<Eigen::Lower>();
+    EXPECT_LE((L * L.transpose() - a).norm(), factor_tolerance(n) * a.norm()) << "n = " << n;
+    for (Eigen::Index j = 1; j < n; ++j)
+      for (Eigen::Index i = 0; i < j; ++i) ASSERT_EQ(work(i, j), 7.0) << "n = " << n;
+  }
+}
+
+TEST(DenseCholesky, FactorizesAViewWithAnOuterStrideInPlace) {
+  const Eigen::Index n = 2 * kLapackMinDimension;
+  const Eigen::MatrixXd a = random_spd(n, 11);
+  Eigen::MatrixXd big = Eigen::MatrixXd::Constant(n + 37, n + 37, -3.0);  // as SquareWorkspace's views
+  big.topLeftCorner(n, n) = a;
+  ASSERT_TRUE(factorize_lower_in_place(big.topLeftCorner(n, n)));
+  const Eigen::MatrixXd L = big.topLeftCorner(n, n).triangularView<Eigen::Lower>();
+  EXPECT_LE((L * L.transpose() - a).norm(), factor_tolerance(n) * a.norm());
+  EXPECT_TRUE((big.bottomRows(37).array() == -3.0).all());
+  EXPECT_TRUE((big.rightCols(37).array() == -3.0).all());
+}
+
+TEST(DenseCholesky, ReportsAnIndefiniteMatrixOnBothPaths) {
+  for (const Eigen::Index n : kSizes) {
+    if (n < 2) continue;
+    Eigen::MatrixXd a = random_spd(n, 5);
+    a(n / 2, n / 2) = -1.0;  // a negative diagonal entry: not positive definite
+    EXPECT_FALSE(factorize_lower_in_place(a)) << "n = " << n;
+    a = random_spd(n, 5) - Eigen::MatrixXd::Identity(n, n);  // eigenvalues in [-1, 0)
+    EXPECT_THROW(cholesky_in_place_or_throw(a, "the test block"), numerical_error) << "n = " << n;
+  }
+}
+
+TEST(DenseCholesky, SolvesWithTheFactorAndGivesItsSquaredPivots) {
+  for (const Eigen::Index n : kSizes) {
+    const Eigen::MatrixXd a = random_spd(n, 3 + static_cast<unsigned>(n));
+    const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+    Eigen::MatrixXd work = a;
+    const LowerCholeskyFactor factor = cholesky_in_place_or_throw(work, "the test block");
+    const Eigen::VectorXd x = factor.solve(b);
+    // cond(a) = 1e4: the residual of a backward-stable solve is a few u |a| |x|.
+    EXPECT_LE((a * x - b).norm(), factor_tolerance(n) * a.norm() * x.norm()) << "n = " << n;
+    const Eigen::LLT<Eigen::MatrixXd> reference(a);
+    EXPECT_TRUE(factor.squared_pivots().isApprox(reference.matrixLLT().diagonal().array().square().matrix(), 1e-10))
+        << "n = " << n;
+  }
+}
+
+TEST(DenseCholesky, ThrowsNamingTheBlockOnNaN) {
+  Eigen::MatrixXd a = random_spd(kLapackMinDimension, 9);
+  a(3, 4) = std::numeric_limits<double>::quiet_NaN();
+  try {
+    cholesky_in_place_or_throw(a, "the test block");
+    FAIL() << "no throw";
+  } catch (const numerical_error& e) {
+    EXPECT_NE(std::string(e.what()).find("the test block has NaN or Inf"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace sextant
