@@ -3,11 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <cstdlib>
 #include <limits>
 #include <random>
 
 #include "sextant/core/error.hpp"
 #include "sextant/core/gaussian.hpp"
+
+#ifdef SEXTANT_HAS_LAPACK
+extern "C" int openblas_get_num_threads();
+#endif
 
 namespace sextant {
 namespace {
@@ -80,6 +85,13 @@ TEST(DenseCholesky, SolvesWithTheFactorAndGivesItsSquaredPivots) {
         << "n = " << n;
   }
 }
+
+#ifdef SEXTANT_HAS_LAPACK
+TEST(DenseCholesky, TheProjectsProgramsRunOpenBlasOnTheCallingThread) {
+  if (std::getenv("OPENBLAS_NUM_THREADS") != nullptr) GTEST_SKIP() << "OPENBLAS_NUM_THREADS is set: it decides";
+  EXPECT_EQ(openblas_get_num_threads(), 1) << "src/blas_on_calling_thread.cpp is not part of this program";
+}
+#endif
 
 TEST(DenseCholesky, ThrowsNamingTheBlockOnNaN) {
   Eigen::MatrixXd a = random_spd(kLapackMinDimension, 9);

@@ -45,7 +45,7 @@ Eigen::MatrixXd sparsification_change_as_matrix(const Eigen::MatrixXd& D, Eigen:
   out.block(0, X, X, n_kept) = change.robot_kept;
   out.topRightCorner(X, n_dropped) = -D.topRightCorner(X, n_dropped);  // the links dropped
   out.bottomLeftCorner(n_R, X) = out.topRightCorner(X, n_R).transpose();
-  out.bottomRightCorner(n_R, n_R) = change.landmarks;
+  out.bottomRightCorner(n_R, n_R) = change.landmarks.template selfadjointView<Eigen::Upper>();  // its upper triangle
   return out;
 }
 

@@ -11,6 +11,8 @@
 #include <cstddef>
 #include <limits>
 
+#include "sextant/core/blas_threads.hpp"
+
 #ifdef SEXTANT_HAS_LAPACK
 /// LAPACK's dpotrf with gfortran's calling convention (the length of `uplo` passed last).
 extern "C" void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info,
@@ -45,9 +47,10 @@ class LowerCholeskyFactor {
  public:
   explicit LowerCholeskyFactor(Eigen::Ref<const Eigen::MatrixXd> factor) : factor_(factor) {}
 
-  /// (L L^T)^-1 b: forward substitution with L, then back substitution with L^T.
-  Eigen::VectorXd solve(const Eigen::VectorXd& b) const {
-    Eigen::VectorXd x = factor_.triangularView<Eigen::Lower>().solve(b);
+  /// (L L^T)^-1 b: forward substitution with L, then back substitution with L^T (b: one column or more).
+  template <class Rhs>
+  typename Rhs::PlainObject solve(const Eigen::MatrixBase<Rhs>& b) const {
+    typename Rhs::PlainObject x = factor_.triangularView<Eigen::Lower>().solve(b);
     factor_.triangularView<Eigen::Lower>().transpose().solveInPlace(x);
     return x;
   }

@@ -15,6 +15,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
+#include "sextant/core/dense_cholesky.hpp"
 #include "sextant/core/gaussian.hpp"
 
 namespace sextant {
@@ -24,7 +25,7 @@ template <int X>
 struct SeifSparsificationChange {
   Eigen::Matrix<double, X, X> robot;  ///< on xx
   Eigen::MatrixXd robot_kept;         ///< on x+ (X x |m+|)
-  Eigen::MatrixXd landmarks;          ///< on RR = (m+, m0) x (m+, m0)
+  Eigen::MatrixXd landmarks;          ///< on RR = (m+, m0) x (m+, m0): its upper triangle only (symmetric)
   /// L_ii^2 of the Cholesky factor of S_xx, the robot block after sparsification: with the robot
   /// ordered first, the factor of the new (x, m+) block is [chol(S_xx), 0; S_+x chol(S_xx)^-T, L_++]
   /// with L_++ that of D_(x+)(x+) (both leave D_++ - D_+x D_xx^-1 D_x+ as the Schur complement).
@@ -39,8 +40,9 @@ SeifSparsificationChange<X> seif_sparsification_change(const Eigen::Matrix<doubl
                                                        const Eigen::MatrixXd& D_xR, const Eigen::MatrixXd& D_0R) {
   using MatrixX = Eigen::Matrix<double, X, X>;
   const Eigen::Index n_dropped = D_0R.rows(), n_kept = D_xR.cols() - n_dropped;
-  const auto llt_00 = cholesky_or_throw(D_0R.rightCols(n_dropped), "information of the landmarks to deactivate");
-  const Eigen::MatrixXd Y = llt_00.solve(D_xR.rightCols(n_dropped).transpose());  // D_00^-1 D_0x
+  Eigen::MatrixXd D_00 = D_0R.rightCols(n_dropped);
+  const auto L_00 = cholesky_in_place_or_throw(D_00, "information of the landmarks to deactivate");
+  const Eigen::MatrixXd Y = L_00.solve(D_xR.rightCols(n_dropped).transpose());  // D_00^-1 D_0x
   SeifSparsificationChange<X> out;
   out.robot = -D_xR.rightCols(n_dropped) * Y;
   out.robot_kept = -Y.transpose() * D_0R.leftCols(n_kept);
@@ -50,8 +52,9 @@ SeifSparsificationChange<X> seif_sparsification_change(const Eigen::Matrix<doubl
   const auto llt_xx = cholesky_or_throw(D_xx, "robot block of the information matrix");
   const Eigen::MatrixXd W = llt_xx.matrixL().solve(D_xR);                                    // -W^T W on RR
   const Eigen::MatrixXd V = llt_S.matrixL().solve(D_xR.leftCols(n_kept) + out.robot_kept);  // +V^T V on ++
-  out.landmarks.noalias() = -W.transpose() * W;
-  out.landmarks.topLeftCorner(n_kept, n_kept).noalias() += V.transpose() * V;
+  out.landmarks.resize(W.cols(), W.cols());
+  out.landmarks.template triangularView<Eigen::Upper>() = -W.transpose() * W;
+  out.landmarks.topLeftCorner(n_kept, n_kept).template triangularView<Eigen::Upper>() += V.transpose() * V;
   return out;
 }
 

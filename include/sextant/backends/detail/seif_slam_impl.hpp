@@ -550,9 +550,13 @@ auto SeifSlam<Motion, Sensor>::sparsify() -> std::optional<Eigen::Matrix<double,
       info_.add_to_robot_link(i, change.robot_kept.template middleCols<M>(M * a));
     else
       info_.remove_robot_link(i);
-    info_.diagonal(i) = symmetrized(info_.diagonal(i) + change.landmarks.template block<M, M>(M * a, M * a));
+    const Eigen::Matrix<double, M, M> change_ii =
+        change.landmarks.template block<M, M>(M * a, M * a).template selfadjointView<Eigen::Upper>();
+    info_.diagonal(i) = symmetrized(info_.diagonal(i) + change_ii);
   }
-  info_.add_to_links(R, [&](std::size_t a, std::size_t b) { return change.landmarks.template block<M, M>(M * a, M * b); });
+  info_.add_to_links(R, [&](std::size_t a, std::size_t b) {  // a < b: the upper triangle, all that is computed
+    return change.landmarks.template block<M, M>(M * a, M * b);
+  });
   active_queue_.resize(kept);
   return change.robot_squared_pivots;
 }
