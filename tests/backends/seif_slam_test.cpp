@@ -78,6 +78,32 @@ TEST(SeifSlam, LinearGaussianProblemEqualsExactBatchLeastSquares) {
   }
 }
 
+TEST(SeifSlam, SparsificationReadsTheBlockMeanRecoveryGatheredAsItWouldGatherItself) {
+  // Sparsification reads the rows of the landmarks it deactivates from the block that active-block
+  // mean recovery gathered (Omega does not change between the two) and gathers them itself when no
+  // such recovery ran (no sweeps, coordinate descent). On a linear problem Omega does not depend on
+  // the means, so every path must leave the same Omega, to the last bit, at every step.
+  const auto steps = test::random_linear_steps(60, 6, 7);
+  std::vector<Seif> filters;
+  for (const auto& [recovery, sweeps] : {std::pair{MeanRecovery::active_block, 1}, std::pair{MeanRecovery::active_block, 0},
+                                         std::pair{MeanRecovery::coordinate_descent, 1}})
+    filters.emplace_back(test::kLinearMotion, test::kLinearSensor, test::kLinearPrior,
+                         SeifOptions{.max_active = 2, .mean_recovery = recovery, .mean_recovery_sweeps = sweeps});
+  Seif exact{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.max_active = 0}};
+  std::size_t sparsified_steps = 0;  // steps after which sparsification held the active set below the exact filter's
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    for (Seif* seif : {&filters[0], &filters[1], &filters[2], &exact}) {
+      seif->predict(steps[k].control, steps[k].dt);
+      seif->update(steps[k].observations);
+    }
+    sparsified_steps += exact.active_landmarks().size() > 2;
+    const Eigen::MatrixXd omega = filters[0].information_matrix();
+    for (std::size_t f = 1; f < filters.size(); ++f)
+      ASSERT_EQ(Eigen::MatrixXd(filters[f].information_matrix()), omega) << "filter " << f << ", step " << k;
+  }
+  EXPECT_GE(sparsified_steps, 10u);  // the test exercises sparsification
+}
+
 TEST(SeifSlam, InformationMatrixStaysPositiveDefiniteAndSparseAtEveryStep) {
   const auto data = sim::simulate_ship_2d({.seed = 6});
   for (std::size_t max_active : {4u, 8u}) {

@@ -9,6 +9,7 @@
 
 #include "sextant/core/error.hpp"
 #include "sextant/core/gaussian.hpp"
+#include "sextant/core/symmetric_rank_update.hpp"
 
 #ifdef SEXTANT_HAS_LAPACK
 extern "C" int openblas_get_num_threads();
@@ -95,12 +96,57 @@ TEST(DenseCholesky, TheProjectsProgramsRunOpenBlasOnTheCallingThread) {
 
 TEST(DenseCholesky, ThrowsNamingTheBlockOnNaN) {
   Eigen::MatrixXd a = random_spd(kLapackMinDimension, 9);
-  a(3, 4) = std::numeric_limits<double>::quiet_NaN();
+  a(4, 3) = std::numeric_limits<double>::quiet_NaN();  // the lower triangle: all that is read
   try {
     cholesky_in_place_or_throw(a, "the test block");
     FAIL() << "no throw";
   } catch (const numerical_error& e) {
     EXPECT_NE(std::string(e.what()).find("the test block has NaN or Inf"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DenseCholesky, ReadsOnlyTheLowerTriangle) {
+  // The SEIF block is gathered into its lower triangle; what the strict upper triangle holds
+  // (NaN here) must not matter, to the factorization nor to the conditioning test.
+  for (const Eigen::Index n : kSizes) {
+    if (n < 2) continue;
+    const Eigen::MatrixXd a = random_spd(n, 13 + static_cast<unsigned>(n));
+    Eigen::MatrixXd with_nan_above = a;
+    with_nan_above.triangularView<Eigen::StrictlyUpper>().setConstant(std::numeric_limits<double>::quiet_NaN());
+    Eigen::MatrixXd clean = a;
+    cholesky_in_place_or_throw(clean, "the test block");
+    Eigen::MatrixXd work = with_nan_above;
+    EXPECT_NO_THROW(cholesky_in_place_or_throw(work, "the test block")) << "n = " << n;
+    EXPECT_EQ(Eigen::MatrixXd(work.triangularView<Eigen::Lower>()), Eigen::MatrixXd(clean.triangularView<Eigen::Lower>()));
+    work = with_nan_above;
+    EXPECT_NO_THROW(require_well_conditioned_in_place(work, "the test block")) << "n = " << n;
+    work = with_nan_above;
+    work(n - 1, 0) = std::numeric_limits<double>::infinity();  // below the diagonal: read, and named
+    EXPECT_THROW(require_well_conditioned_in_place(work, "the test block"), numerical_error) << "n = " << n;
+  }
+}
+
+TEST(SymmetricRankUpdate, IsAlphaATransposeAPlusBetaCOnTheUpperTriangleOnBothPaths) {
+  std::mt19937 rng(21);
+  std::normal_distribution<double> normal;
+  for (const Eigen::Index n : kSizes) {
+    for (const Eigen::Index k : {Eigen::Index{1}, Eigen::Index{12}}) {
+      const Eigen::MatrixXd A = Eigen::MatrixXd::NullaryExpr(k, n, [&] { return normal(rng); });
+      const Eigen::MatrixXd C0 = Eigen::MatrixXd::NullaryExpr(n, n, [&] { return normal(rng); });
+      for (const double beta : {0.0, 1.0, 0.5}) {
+        Eigen::MatrixXd C = C0;
+        if (beta == 0.0)  // not read: garbage must not leak through
+          C.triangularView<Eigen::Upper>().setConstant(std::numeric_limits<double>::quiet_NaN());
+        symmetric_rank_update_upper(C, A, -1.5, beta);
+        const Eigen::MatrixXd expected = -1.5 * A.transpose() * A + beta * C0;
+        const double scale = expected.cwiseAbs().maxCoeff();
+        const Eigen::MatrixXd upper_error = (C - expected).triangularView<Eigen::Upper>();
+        EXPECT_LE(upper_error.cwiseAbs().maxCoeff(), 1e-13 * scale) << "n " << n << " k " << k << " beta " << beta;
+        EXPECT_EQ(Eigen::MatrixXd(C.triangularView<Eigen::StrictlyLower>()),
+                  Eigen::MatrixXd(C0.triangularView<Eigen::StrictlyLower>()))
+            << "the strict lower triangle changed, n " << n;
+      }
+    }
   }
 }
 

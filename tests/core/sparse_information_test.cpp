@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <map>
 #include <random>
 #include <vector>
 
@@ -40,7 +41,8 @@ Eigen::MatrixXd random_changes(std::size_t count, std::mt19937& rng) {
 TEST(SparseInformation, AddToLinksIsAddToLinkPairByPairBitForBit) {
   // add_to_links writes one landmark's links at a time; the result must be what add_to_link gives
   // pair by pair, to the bit, for slots in any order (SEIF passes its queue order) and for pairs
-  // that are linked already and pairs that are not.
+  // that are linked already and pairs that are not. Each pair below the diagonal is reported once,
+  // with its new block (SEIF's motion update builds the block it checks from them).
   std::mt19937 rng(11);
   const Info start = random_form(30, rng);
   for (int trial = 0; trial < 20; ++trial) {
@@ -51,7 +53,16 @@ TEST(SparseInformation, AddToLinksIsAddToLinkPairByPairBitForBit) {
     const Eigen::MatrixXd changes = random_changes(slots.size(), rng);
     auto change = [&](std::size_t a, std::size_t b) { return Block(changes.block<2, 2>(2 * a, 2 * b)); };
     Info by_rows = start, by_pairs = start;
-    by_rows.add_to_links(slots, change);
+    std::map<std::pair<std::size_t, std::size_t>, Block> reported;  // the new blocks below the diagonal
+    by_rows.add_to_links(slots, change, [&](std::size_t a, std::size_t b, const Block& block) {
+      EXPECT_GT(a, b);
+      EXPECT_TRUE(reported.emplace(std::pair(a, b), block).second) << "reported twice: " << a << ", " << b;
+    });
+    EXPECT_EQ(reported.size(), slots.size() * (slots.size() - 1) / 2);
+    for (const auto& [pair, block] : reported) {
+      EXPECT_EQ(block, by_rows.landmark_block(slots[pair.first], slots[pair.second])) << "trial " << trial;
+      EXPECT_EQ(block, by_rows.landmark_block(slots[pair.second], slots[pair.first]).transpose()) << "trial " << trial;
+    }
     for (std::size_t a = 0; a < slots.size(); ++a)
       for (std::size_t b = a + 1; b < slots.size(); ++b) by_pairs.add_to_link(slots[a], slots[b], change(a, b));
     EXPECT_EQ(Eigen::MatrixXd(by_rows.to_sparse()), Eigen::MatrixXd(by_pairs.to_sparse())) << "trial " << trial;

@@ -38,14 +38,14 @@ inline Eigen::MatrixXd thesis_sparsification_change(const Eigen::MatrixXd& D, Ei
 template <int X>
 Eigen::MatrixXd sparsification_change_as_matrix(const Eigen::MatrixXd& D, Eigen::Index n_kept) {
   const Eigen::Index n_R = D.rows() - X, n_dropped = n_R - n_kept;
-  const auto change = seif_sparsification_change<X>(D.topLeftCorner<X, X>(), D.topRightCorner(X, n_R),
-                                                    D.bottomRightCorner(n_dropped, n_R));
+  Eigen::MatrixXd D_0R = D.bottomRightCorner(n_dropped, n_R), change_on_RR(n_R, n_R);
+  const auto change = seif_sparsification_change<X>(D.topLeftCorner<X, X>(), D.topRightCorner(X, n_R), D_0R, change_on_RR);
   Eigen::MatrixXd out(D.rows(), D.cols());
   out.topLeftCorner<X, X>() = change.robot;
   out.block(0, X, X, n_kept) = change.robot_kept;
   out.topRightCorner(X, n_dropped) = -D.topRightCorner(X, n_dropped);  // the links dropped
   out.bottomLeftCorner(n_R, X) = out.topRightCorner(X, n_R).transpose();
-  out.bottomRightCorner(n_R, n_R) = change.landmarks.template selfadjointView<Eigen::Upper>();  // its upper triangle
+  out.bottomRightCorner(n_R, n_R) = change_on_RR.selfadjointView<Eigen::Upper>();  // its upper triangle
   return out;
 }
 

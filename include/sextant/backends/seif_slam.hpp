@@ -223,6 +223,11 @@ class SeifSlam {
   Eigen::VectorXd recover_mean_of_active_block() { return recover_mean_of_block(active_queue_); }
   Eigen::VectorXd recover_mean_of_block(const std::vector<std::size_t>& slots);
   void robot_and_landmarks_block(const std::vector<std::size_t>& slots, Eigen::Ref<Eigen::MatrixXd> D) const;
+  void gather_links_below(const std::vector<std::size_t>& slots, std::size_t a, Eigen::Ref<Eigen::MatrixXd> D,
+                          std::size_t first) const;
+  void fill_robot_and_diagonal_blocks(const std::vector<std::size_t>& slots, Eigen::Ref<Eigen::MatrixXd> D) const;
+  void require_factorizable_block(const std::vector<std::size_t>& slots, Eigen::Ref<Eigen::MatrixXd> D,
+                                  const char* what) const;
   /// A predicate true for exactly the given slots, valid until the next call.
   auto mark_slots(const std::vector<std::size_t>& slots);
   void update_active_queue(const std::vector<std::size_t>& observed_slots);
@@ -235,8 +240,10 @@ class SeifSlam {
   /// only; leaves the robot with no information and no links.
   void marginalize_robot();
   void relocalize(const std::vector<MeasurementInformation>& held_back, std::vector<std::size_t> observed);
-  /// The squared pivots of the Cholesky factor of S_xx when it sparsified.
-  std::optional<Eigen::Matrix<double, X, 1>> sparsify();
+  /// The squared pivots of the Cholesky factor of S_xx when it sparsified. `active_block_gathered`:
+  /// block_workspace_ holds Omega over (robot, active queue) as mean recovery gathered it (Omega has
+  /// not changed since), which sparsification then reads instead of gathering its rows again.
+  std::optional<Eigen::Matrix<double, X, 1>> sparsify(bool active_block_gathered);
   void require_factorizable_after_update(const std::optional<Eigen::VectorXd>& squared_pivots,
                                          const std::optional<Eigen::Matrix<double, X, 1>>& robot_squared_pivots);
   std::shared_ptr<const Factor> factorization() const;

@@ -46,10 +46,19 @@ Eigen::LLT<typename Derived::PlainObject> cholesky_or_throw(const Eigen::MatrixB
   return llt;
 }
 
-/// cholesky_or_throw for a large dynamic block that is not needed afterwards: `a` is overwritten
-/// with its factor (core/dense_cholesky.hpp), which the returned view refers to (no copy).
+/// Whether the lower triangle of a square matrix (all that a Cholesky factorization reads) is finite.
+template <class Derived>
+bool lower_triangle_is_finite(const Eigen::MatrixBase<Derived>& a) {
+  for (Eigen::Index j = 0; j < a.cols(); ++j)
+    if (!a.col(j).tail(a.rows() - j).allFinite()) return false;
+  return true;
+}
+
+/// cholesky_or_throw for a large dynamic block that is not needed afterwards: the lower triangle of
+/// `a` (all that is read) is overwritten with its factor (core/dense_cholesky.hpp), which the
+/// returned view refers to (no copy).
 inline LowerCholeskyFactor cholesky_in_place_or_throw(Eigen::Ref<Eigen::MatrixXd> a, const std::string& what) {
-  if (!a.allFinite()) throw numerical_error(what + " has NaN or Inf entries");
+  if (!lower_triangle_is_finite(a)) throw numerical_error(what + " has NaN or Inf entries");
   if (!factorize_lower_in_place(a)) throw numerical_error(what + " is not positive definite");
   return LowerCholeskyFactor(a);
 }
@@ -77,15 +86,15 @@ inline void require_well_conditioned_pivots(const Eigen::VectorXd& pivots, const
   }
 }
 
-/// require_well_conditioned on a matrix it may overwrite (with its scaled Cholesky factor), for a
-/// large block that is not needed afterwards: no copy.
+/// require_well_conditioned on a matrix whose lower triangle (all that is read) it may overwrite
+/// (with its scaled Cholesky factor), for a large block that is not needed afterwards: no copy.
 template <class Derived>
 void require_well_conditioned_in_place(Eigen::MatrixBase<Derived>& a, const std::string& what) {
   using Plain = typename Derived::PlainObject;
-  if (!a.allFinite()) throw numerical_error(what + " has NaN or Inf entries");
+  if (!lower_triangle_is_finite(a)) throw numerical_error(what + " has NaN or Inf entries");
   if (!(a.diagonal().array() > 0.0).all()) throw numerical_error(what + " is not positive definite");
   const Eigen::VectorXd scale = a.diagonal().array().rsqrt().matrix();
-  a = scale.asDiagonal() * a * scale.asDiagonal();
+  a.template triangularView<Eigen::Lower>() = scale.asDiagonal() * a * scale.asDiagonal();
   bool positive_definite = false;
   if constexpr (Derived::RowsAtCompileTime == Eigen::Dynamic) {
     positive_definite = factorize_lower_in_place(a.derived());

@@ -17,6 +17,7 @@
 
 #include "sextant/core/dense_cholesky.hpp"
 #include "sextant/core/gaussian.hpp"
+#include "sextant/core/symmetric_rank_update.hpp"
 
 namespace sextant {
 
@@ -24,8 +25,7 @@ namespace sextant {
 template <int X>
 struct SeifSparsificationChange {
   Eigen::Matrix<double, X, X> robot;  ///< on xx
-  Eigen::MatrixXd robot_kept;         ///< on x+ (X x |m+|)
-  Eigen::MatrixXd landmarks;          ///< on RR = (m+, m0) x (m+, m0): its upper triangle only (symmetric)
+  Eigen::MatrixXd robot_kept;         ///< on x+ (X x |m+|); the change on RR goes to the caller's matrix
   /// L_ii^2 of the Cholesky factor of S_xx, the robot block after sparsification: with the robot
   /// ordered first, the factor of the new (x, m+) block is [chol(S_xx), 0; S_+x chol(S_xx)^-T, L_++]
   /// with L_++ that of D_(x+)(x+) (both leave D_++ - D_+x D_xx^-1 D_x+ as the Schur complement).
@@ -33,15 +33,18 @@ struct SeifSparsificationChange {
 };
 
 /// D_xx = Omega_xx; D_xR = Omega_{x, (m+, m0)}; D_0R = Omega_{m0, (m+, m0)} (the rows of the
-/// landmarks to deactivate). Throws numerical_error, naming the block, when D_00, S_xx or D_xx is
-/// not positive definite.
+/// landmarks to deactivate), whose last |m0| columns (D_00) are overwritten with their Cholesky
+/// factor. The change on RR = (m+, m0) x (m+, m0) is written into the upper triangle of
+/// `change_on_RR` (|R| x |R|, the caller's storage: at the thesis's scale a 5 MB matrix, which
+/// allocated afresh every frame page-faulted for 7% of the run). Throws numerical_error, naming the
+/// block, when D_00, S_xx or D_xx is not positive definite; `change_on_RR` is then unspecified.
 template <int X>
 SeifSparsificationChange<X> seif_sparsification_change(const Eigen::Matrix<double, X, X>& D_xx,
-                                                       const Eigen::MatrixXd& D_xR, const Eigen::MatrixXd& D_0R) {
+                                                       const Eigen::MatrixXd& D_xR, Eigen::Ref<Eigen::MatrixXd> D_0R,
+                                                       Eigen::Ref<Eigen::MatrixXd> change_on_RR) {
   using MatrixX = Eigen::Matrix<double, X, X>;
   const Eigen::Index n_dropped = D_0R.rows(), n_kept = D_xR.cols() - n_dropped;
-  Eigen::MatrixXd D_00 = D_0R.rightCols(n_dropped);
-  const auto L_00 = cholesky_in_place_or_throw(D_00, "information of the landmarks to deactivate");
+  const auto L_00 = cholesky_in_place_or_throw(D_0R.rightCols(n_dropped), "information of the landmarks to deactivate");
   const Eigen::MatrixXd Y = L_00.solve(D_xR.rightCols(n_dropped).transpose());  // D_00^-1 D_0x
   SeifSparsificationChange<X> out;
   out.robot = -D_xR.rightCols(n_dropped) * Y;
@@ -52,9 +55,8 @@ SeifSparsificationChange<X> seif_sparsification_change(const Eigen::Matrix<doubl
   const auto llt_xx = cholesky_or_throw(D_xx, "robot block of the information matrix");
   const Eigen::MatrixXd W = llt_xx.matrixL().solve(D_xR);                                    // -W^T W on RR
   const Eigen::MatrixXd V = llt_S.matrixL().solve(D_xR.leftCols(n_kept) + out.robot_kept);  // +V^T V on ++
-  out.landmarks.resize(W.cols(), W.cols());
-  out.landmarks.template triangularView<Eigen::Upper>() = -W.transpose() * W;
-  out.landmarks.topLeftCorner(n_kept, n_kept).template triangularView<Eigen::Upper>() += V.transpose() * V;
+  symmetric_rank_update_upper(change_on_RR, W, -1.0, 0.0);
+  symmetric_rank_update_upper(change_on_RR.topLeftCorner(n_kept, n_kept), V, 1.0, 1.0);
   return out;
 }
 

@@ -87,9 +87,11 @@ class SparseInformation {
   /// positions a < b of `slots` (distinct slots): add_to_link for all pairs, done one landmark's
   /// links at a time, so that each map is probed while it is in cache (pair by pair, every second
   /// write goes to a cold map). change(a, b) is called once from each side and must return the same
-  /// block both times.
-  template <class Change>
-  void add_to_links(std::span<const std::size_t> slots, Change change) {
+  /// block both times. `changed(a, b, block)`, if given, is called for every pair a > b with the new
+  /// Omega_{s_a, s_b} (a caller that needs the block afterwards as a dense matrix, its lower
+  /// triangle, gets it without looking the links up again).
+  template <class Change, class Changed = decltype([](std::size_t, std::size_t, const LandmarkBlock&) {})>
+  void add_to_links(std::span<const std::size_t> slots, Change change, Changed changed = {}) {
     for (std::size_t a = 0; a < slots.size(); ++a) {
       const std::size_t i = slots[a];
       Links& row = links_[i];
@@ -102,6 +104,7 @@ class SparseInformation {
         if (open_ && i < j && i < journal_.landmarks)  // the pair's record, made from its first slot's side
           journal_.links.push_back({i, j, inserted ? std::nullopt : std::optional<LandmarkBlock>(it->second)});
         if (!inserted) it->second += block;
+        if (b < a) changed(a, b, it->second);
       }
     }
   }

@@ -15,7 +15,6 @@
 #include "sextant/core/factor_information.hpp"
 #include "sextant/core/landmark_init.hpp"
 #include "sextant/core/seif_sparsification.hpp"
-#include "sextant/core/symmetric_matrix.hpp"
 #include "sextant/core/validation.hpp"
 
 namespace sextant {
@@ -61,28 +60,38 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   const MatrixX T = symmetrized(
       (MatrixX::Identity() + prediction.R * Phi_xx).partialPivLu().solve(prediction.R));
   const MatrixX A = (MatrixX::Identity() + Phi_xx * prediction.R).partialPivLu().solve(MatrixX::Identity());
-  std::vector<std::pair<std::size_t, Eigen::Matrix<double, X, M>>> Phi_x;  // Phi_xj of the active landmarks
-  Phi_x.reserve(info_.robot_links().size());
-  for (const auto& [slot, block] : info_.robot_links()) Phi_x.emplace_back(slot, G_inv_T * block);
+  std::vector<std::size_t> active;  // the active landmarks, in the order of Phi_xA's columns
+  Eigen::MatrixXd Phi_xA(X, M * static_cast<Eigen::Index>(info_.robot_links().size()));
+  for (const auto& [slot, block] : info_.robot_links()) {
+    Phi_xA.template middleCols<M>(M * static_cast<Eigen::Index>(active.size())) = G_inv_T * block;
+    active.push_back(slot);
+  }
   const Eigen::Matrix<double, X, 1> r_x = G_inv_T * info_.robot_residual();
+  auto change = factor_workspace_.view(Phi_xA.cols());  // -Phi_Ax T Phi_xA on the active pairs: its upper triangle
+  change.template triangularView<Eigen::Upper>() = -Phi_xA.transpose() * (T * Phi_xA);
+  auto at = [](std::size_t a) { return M * static_cast<Eigen::Index>(a); };
 
   atomically([&] {
     info_.robot() = symmetrized(A * Phi_xx);
     info_.robot_residual() = A * r_x;
     const Eigen::Matrix<double, X, 1> T_r_x = T * r_x;
-    std::vector<std::size_t> active(Phi_x.size());
-    std::vector<Eigen::Matrix<double, M, X>> Phi_T(Phi_x.size());  // Phi_xi^T T
-    for (std::size_t a = 0; a < Phi_x.size(); ++a) {
-      const auto& [i, Phi_xi] = Phi_x[a];
-      active[a] = i;
+    for (std::size_t a = 0; a < active.size(); ++a) {
+      const std::size_t i = active[a];
+      const auto Phi_xi = Phi_xA.template middleCols<M>(at(a));
       info_.set_robot_link(i, A * Phi_xi);
-      Phi_T[a] = Phi_xi.transpose() * T;
-      info_.diagonal(i) = symmetrized(info_.diagonal(i) - Phi_T[a] * Phi_xi);
+      const Eigen::Matrix<double, M, M> change_ii = change.template block<M, M>(at(a), at(a)).template selfadjointView<Eigen::Upper>();
+      info_.diagonal(i) = symmetrized(info_.diagonal(i) + change_ii);
       info_.landmark_residual(i) -= Phi_xi.transpose() * T_r_x;
     }
-    info_.add_to_links(active, [&](std::size_t a, std::size_t b) { return -Phi_T[a] * Phi_x[b].second; });
+    auto D = block_workspace_.view(X + at(active.size()));  // the (x, active) block after the update, for its check
+    info_.add_to_links(
+        active, [&](std::size_t a, std::size_t b) { return change.template block<M, M>(at(a), at(b)); },
+        [&](std::size_t a, std::size_t b, const Eigen::Matrix<double, M, M>& block) {
+          D.template block<M, M>(X + at(a), X + at(b)) = block;
+        });
     x_ = prediction.x;
-    require_factorizable_robot_and_active("SEIF motion update");
+    require_finite_robot_and_active("SEIF motion update");
+    require_factorizable_block(active, D, "SEIF motion update");
   });
   propagated_ = prediction.x;
 }
@@ -196,7 +205,7 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
       squared_pivots = recover_mean_locally();
     times.mean_recovery_s = seconds_since(stage_start);
     stage_start = Clock::now();
-    const auto robot_squared_pivots = sparsify();
+    const auto robot_squared_pivots = sparsify(squared_pivots.has_value());
     require_factorizable_after_update(squared_pivots, robot_squared_pivots);
     times.sparsification_s = seconds_since(stage_start);
   });
@@ -282,7 +291,16 @@ void SeifSlam<Motion, Sensor>::require_factorizable_robot_and_active(const char*
   std::vector<std::size_t> slots;
   for (const auto& [slot, block] : info_.robot_links()) slots.push_back(slot);
   auto D = block_workspace_.view(X + M * static_cast<Eigen::Index>(slots.size()));
-  robot_and_landmarks_block(slots, D);
+  for (std::size_t a = 0; a < slots.size(); ++a) gather_links_below(slots, a, D, a + 1);
+  require_factorizable_block(slots, D, what);
+}
+
+/// require_factorizable_robot_and_active's test on D, whose links below the diagonal blocks hold
+/// Omega over (robot, slots...) already: D is completed and factorized (overwritten).
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::require_factorizable_block(const std::vector<std::size_t>& slots,
+                                                         Eigen::Ref<Eigen::MatrixXd> D, const char* what) const {
+  fill_robot_and_diagonal_blocks(slots, D);
   require_well_conditioned_in_place(D, std::string(what) + ": the information of the robot and the active landmarks");
 }
 
@@ -317,23 +335,39 @@ std::optional<Eigen::VectorXd> SeifSlam<Motion, Sensor>::recover_mean_locally() 
   return squared_pivots;
 }
 
-/// Omega restricted to (robot, slots...) as a dense matrix, written into D (X + M |slots| square):
-/// the links into the lower triangle, which is read down its columns, one landmark's links at a
-/// time, then mirrored in tiles, then the diagonal blocks whole.
+/// Omega restricted to (robot, slots...) as a dense matrix, written into the lower triangle of D
+/// (X + M |slots| square; the diagonal blocks whole, the rest of the strict upper triangle
+/// unspecified: the factorization and the products that read D read only the lower triangle),
+/// down its columns, one landmark's links at a time.
 template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::robot_and_landmarks_block(const std::vector<std::size_t>& slots,
                                                          Eigen::Ref<Eigen::MatrixXd> D) const {
+  for (std::size_t a = 0; a < slots.size(); ++a) gather_links_below(slots, a, D, a + 1);
+  fill_robot_and_diagonal_blocks(slots, D);
+}
+
+/// The links of slots[a] to slots[first], slots[first + 1], ... (first > a), into D's column of
+/// slots[a] below its diagonal block.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::gather_links_below(const std::vector<std::size_t>& slots, std::size_t a,
+                                                  Eigen::Ref<Eigen::MatrixXd> D, std::size_t first) const {
   auto at = [](std::size_t k) { return X + M * static_cast<Eigen::Index>(k); };
+  const auto below = std::span(slots).subspan(first);  // one look-up per pair
+  info_.for_each_block_in_row(slots[a], below, [&](std::size_t b, const Eigen::Matrix<double, M, M>& block) {
+    D.template block<M, M>(at(first + b), at(a)) = block.transpose();
+  });
+}
+
+/// D's robot block, the robot's links (its first X columns) and the landmarks' diagonal blocks.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::fill_robot_and_diagonal_blocks(const std::vector<std::size_t>& slots,
+                                                              Eigen::Ref<Eigen::MatrixXd> D) const {
+  auto at = [](std::size_t k) { return X + M * static_cast<Eigen::Index>(k); };
+  D.template topLeftCorner<X, X>() = info_.robot();
   for (std::size_t a = 0; a < slots.size(); ++a) {
     D.template block<M, X>(at(a), 0) = info_.robot_link(slots[a]).transpose();
-    const auto below = std::span(slots).subspan(a + 1);  // one look-up per pair
-    info_.for_each_block_in_row(slots[a], below, [&](std::size_t b, const Eigen::Matrix<double, M, M>& block) {
-      D.template block<M, M>(at(a + 1 + b), at(a)) = block.transpose();
-    });
+    D.template block<M, M>(at(a), at(a)) = info_.diagonal(slots[a]);
   }
-  mirror_lower_to_upper(D);
-  D.template topLeftCorner<X, X>() = info_.robot();
-  for (std::size_t a = 0; a < slots.size(); ++a) D.template block<M, M>(at(a), at(a)) = info_.diagonal(slots[a]);
 }
 
 /// Solves Omega_BB delta_B = r_B for B = robot + `slots` (in that order; the active landmarks in the
@@ -348,10 +382,10 @@ Eigen::VectorXd SeifSlam<Motion, Sensor>::recover_mean_of_block(const std::vecto
   r.template head<X>() = info_.robot_residual();
   for (std::size_t a = 0; a < slots.size(); ++a) r.template segment<M>(X + M * a) = info_.landmark_residual(slots[a]);
   auto factor = factor_workspace_.view(d);
-  factor = D;
+  factor.template triangularView<Eigen::Lower>() = D;
   const auto L = cholesky_in_place_or_throw(factor, "information of the robot and the active landmarks");
   const Eigen::VectorXd delta = L.solve(r);
-  const Eigen::VectorXd r_after = r - D * delta;
+  const Eigen::VectorXd r_after = r - D.template selfadjointView<Eigen::Lower>() * delta;
   x_ = Space::plus(x_, delta.template head<X>());
   info_.robot_residual() = r_after.template head<X>();
   const auto in_block = mark_slots(slots);
@@ -529,20 +563,22 @@ void SeifSlam<Motion, Sensor>::update_active_queue(const std::vector<std::size_t
 /// the queue (m+) and loses those to the rest (m0); the change of Omega on B = (x, m+, m0) is
 /// core/seif_sparsification.hpp's. The residual r is unchanged (eq. 44).
 template <class Motion, class Sensor>
-auto SeifSlam<Motion, Sensor>::sparsify() -> std::optional<Eigen::Matrix<double, X, 1>> {
+auto SeifSlam<Motion, Sensor>::sparsify(bool active_block_gathered) -> std::optional<Eigen::Matrix<double, X, 1>> {
   if (options_.max_active == 0 || active_queue_.size() <= options_.max_active) return std::nullopt;
   if (options_.sparsification == SeifSparsification::relocalization) return std::nullopt;  // waits for relocalize()
   const std::vector<std::size_t>& R = active_queue_;
   const std::size_t kept = options_.max_active;
   const Eigen::Index n_R = M * static_cast<Eigen::Index>(R.size());
   const Eigen::Index n_dropped = n_R - M * static_cast<Eigen::Index>(kept);
-  Eigen::MatrixXd D_xR(X, n_R), D_0R(n_dropped, n_R);  // robot rows; rows of the landmarks to deactivate
-  for (std::size_t b = 0; b < R.size(); ++b) D_xR.template middleCols<M>(M * b) = info_.robot_link(R[b]);
-  for (std::size_t a = kept; a < R.size(); ++a)  // row by row: one landmark's links at a time
-    info_.for_each_block_in_row(R[a], R, [&](std::size_t b, const Eigen::Matrix<double, M, M>& block) {
-      D_0R.template block<M, M>(M * (a - kept), M * b) = block;
-    });
-  const auto change = seif_sparsification_change<X>(info_.robot(), D_xR, D_0R);
+  auto D = block_workspace_.view(X + n_R);  // Omega over (x, R), its lower triangle
+  if (!active_block_gathered) {  // the rows of m0 are all it needs
+    for (std::size_t a = 0; a < R.size(); ++a) gather_links_below(R, a, D, std::max(a + 1, kept));
+    fill_robot_and_diagonal_blocks(R, D);
+  }
+  const Eigen::MatrixXd D_xR = D.block(X, 0, n_R, X).transpose();
+  auto D_0R = D.block(X + n_R - n_dropped, X, n_dropped, n_R);  // rows of the landmarks to deactivate
+  auto change_on_RR = factor_workspace_.view(n_R);
+  const auto change = seif_sparsification_change<X>(info_.robot(), D_xR, D_0R, change_on_RR);
   info_.robot() = symmetrized(info_.robot() + change.robot);
   for (std::size_t a = 0; a < R.size(); ++a) {
     const std::size_t i = R[a];
@@ -551,11 +587,11 @@ auto SeifSlam<Motion, Sensor>::sparsify() -> std::optional<Eigen::Matrix<double,
     else
       info_.remove_robot_link(i);
     const Eigen::Matrix<double, M, M> change_ii =
-        change.landmarks.template block<M, M>(M * a, M * a).template selfadjointView<Eigen::Upper>();
+        change_on_RR.template block<M, M>(M * a, M * a).template selfadjointView<Eigen::Upper>();
     info_.diagonal(i) = symmetrized(info_.diagonal(i) + change_ii);
   }
   info_.add_to_links(R, [&](std::size_t a, std::size_t b) {  // a < b: the upper triangle, all that is computed
-    return change.landmarks.template block<M, M>(M * a, M * b);
+    return change_on_RR.template block<M, M>(M * a, M * b);
   });
   active_queue_.resize(kept);
   return change.robot_squared_pivots;
