@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "sextant/core/backend_types.hpp"
+#include "sextant/core/closed_form_landmarks.hpp"
 #include "sextant/core/landmark_store.hpp"
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/conditionally_linear.hpp"
@@ -220,8 +221,22 @@ class SeifSlam {
   /// The squared pivots of the active block's factor when one was computed (active_block recovery).
   std::optional<Eigen::VectorXd> recover_mean_locally();
   void recover_mean_by_coordinate_descent();
-  Eigen::VectorXd recover_mean_of_active_block() { return recover_mean_of_block(active_queue_); }
-  Eigen::VectorXd recover_mean_of_block(const std::vector<std::size_t>& slots);
+  /// Whether this update's sparsification will deactivate landmarks (the thesis's; ESEIF relocalizes).
+  bool sparsification_due() const {
+    return options_.sparsification == SeifSparsification::thesis && options_.max_active > 0 &&
+           active_queue_.size() > options_.max_active;
+  }
+  Eigen::VectorXd recover_mean_of_active_block() {
+    const bool sparsifies = sparsification_due();
+    return recover_mean_of_block(active_queue_, sparsifies ? options_.max_active : active_queue_.size(), sparsifies);
+  }
+  Eigen::VectorXd recover_mean_of_block(const std::vector<std::size_t>& slots, std::size_t leading,
+                                        bool sparsification_follows);
+  /// The positions in B = (robot, slots...) of the landmarks among the first `leading` of `slots`
+  /// that have no landmark links (linked to the robot alone: those this update added).
+  std::vector<Eigen::Index> unlinked_positions(const std::vector<std::size_t>& slots, std::size_t leading) const;
+  void apply_mean_recovery(const std::vector<std::size_t>& slots, const Eigen::VectorXd& delta,
+                           const Eigen::VectorXd& r_after);
   void robot_and_landmarks_block(const std::vector<std::size_t>& slots, Eigen::Ref<Eigen::MatrixXd> D) const;
   void gather_links_below(const std::vector<std::size_t>& slots, std::size_t a, Eigen::Ref<Eigen::MatrixXd> D,
                           std::size_t first) const;

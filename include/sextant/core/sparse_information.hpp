@@ -23,6 +23,12 @@
 
 namespace sextant {
 
+/// SparseInformation::add_to_links' report of the new blocks when the caller wants none.
+struct IgnoreChangedLinks {
+  template <class Block>
+  void operator()(std::size_t, std::size_t, const Block&) const {}
+};
+
 template <int X, int M>
 class SparseInformation {
  public:
@@ -90,7 +96,7 @@ class SparseInformation {
   /// block both times. `changed(a, b, block)`, if given, is called for every pair a > b with the new
   /// Omega_{s_a, s_b} (a caller that needs the block afterwards as a dense matrix, its lower
   /// triangle, gets it without looking the links up again).
-  template <class Change, class Changed = decltype([](std::size_t, std::size_t, const LandmarkBlock&) {})>
+  template <class Change, class Changed = IgnoreChangedLinks>
   void add_to_links(std::span<const std::size_t> slots, Change change, Changed changed = {}) {
     for (std::size_t a = 0; a < slots.size(); ++a) {
       const std::size_t i = slots[a];

@@ -372,20 +372,62 @@ void SeifSlam<Motion, Sensor>::fill_robot_and_diagonal_blocks(const std::vector<
 
 /// Solves Omega_BB delta_B = r_B for B = robot + `slots` (in that order; the active landmarks in the
 /// queue's order), moves their means, and passes the change on to the residuals of their neighbours
-/// outside B: r_b -= Omega_bB delta_B. Returns the squared diagonal of the Cholesky factor of Omega_BB.
+/// outside B: r_b -= Omega_bB delta_B. Landmarks among the first `leading` of `slots` that are linked
+/// to the robot alone (the ones this update added) are eliminated first, in closed form: their rows
+/// hold only their diagonal block W_u and their robot link, so eliminating them changes only the
+/// robot's block, to Omega_xx - sum_u Omega_xu W_u^-1 Omega_ux, and the dense factorization works on
+/// the rest (at the thesis's scale ~700 of ~790 dimensions: a third fewer flops). Returns squared
+/// pivots, one per dimension of B in B's order, of a factorization of the block that
+/// require_factorizable_after_update checks, (robot, the first `leading` slots) after this update:
+/// ordered (closed-form landmarks, robot, the rest) as computed when no sparsification follows;
+/// when one does, ordered (robot, closed-form landmarks, the rest) with the robot's pivots left for
+/// sparsification to give (core/seif_sparsification.hpp) and the closed-form landmarks' from the
+/// Schur complement of the robot over them, which sparsification leaves as it is.
 template <class Motion, class Sensor>
-Eigen::VectorXd SeifSlam<Motion, Sensor>::recover_mean_of_block(const std::vector<std::size_t>& slots) {
+Eigen::VectorXd SeifSlam<Motion, Sensor>::recover_mean_of_block(const std::vector<std::size_t>& slots,
+                                                                std::size_t leading, bool sparsification_follows) {
   const Eigen::Index d = X + M * static_cast<Eigen::Index>(slots.size());
   auto D = block_workspace_.view(d);
   robot_and_landmarks_block(slots, D);
   Eigen::VectorXd r(d);
   r.template head<X>() = info_.robot_residual();
   for (std::size_t a = 0; a < slots.size(); ++a) r.template segment<M>(X + M * a) = info_.landmark_residual(slots[a]);
-  auto factor = factor_workspace_.view(d);
-  factor.template triangularView<Eigen::Lower>() = D;
-  const auto L = cholesky_in_place_or_throw(factor, "information of the robot and the active landmarks");
-  const Eigen::VectorXd delta = L.solve(r);
-  const Eigen::VectorXd r_after = r - D.template selfadjointView<Eigen::Lower>() * delta;
+  constexpr const char* what = "information of the robot and the active landmarks";
+  const ClosedFormLandmarks<X, M> closed(D, r, unlinked_positions(slots, leading), what);
+  const std::vector<Eigen::Index> dense = closed.dense_dimensions(d);
+  auto factor = factor_workspace_.view(static_cast<Eigen::Index>(dense.size()));
+  closed.copy_dense_lower_triangle(D, factor);
+  factor.template topLeftCorner<X, X>() = closed.robot_information();
+  const auto L = cholesky_in_place_or_throw(factor, what);
+  Eigen::VectorXd r_dense = r(dense);
+  r_dense.template head<X>() = closed.robot_residual();
+  Eigen::VectorXd delta(d);
+  delta(dense) = L.solve(r_dense);
+  closed.back_substitute(delta);
+  Eigen::VectorXd pivots(d);
+  pivots(dense) = L.squared_pivots();
+  if (sparsification_follows)
+    closed.squared_pivots_after_robot(D, pivots);
+  else
+    closed.squared_pivots_first(pivots);
+  apply_mean_recovery(slots, delta, r - D.template selfadjointView<Eigen::Lower>() * delta);
+  return pivots;
+}
+
+/// The positions in B of the landmarks among the first `leading` of `slots` without landmark links.
+template <class Motion, class Sensor>
+std::vector<Eigen::Index> SeifSlam<Motion, Sensor>::unlinked_positions(const std::vector<std::size_t>& slots,
+                                                                      std::size_t leading) const {
+  std::vector<Eigen::Index> out;
+  for (std::size_t a = 0; a < std::min(leading, slots.size()); ++a)
+    if (info_.links(slots[a]).empty()) out.push_back(X + M * static_cast<Eigen::Index>(a));
+  return out;
+}
+
+/// The new means of the robot and the block's landmarks (delta) and their residuals after it.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::apply_mean_recovery(const std::vector<std::size_t>& slots, const Eigen::VectorXd& delta,
+                                                   const Eigen::VectorXd& r_after) {
   x_ = Space::plus(x_, delta.template head<X>());
   info_.robot_residual() = r_after.template head<X>();
   const auto in_block = mark_slots(slots);
@@ -396,7 +438,6 @@ Eigen::VectorXd SeifSlam<Motion, Sensor>::recover_mean_of_block(const std::vecto
     for (const auto& [neighbour, block] : info_.links(slots[a]))
       if (!in_block(neighbour)) info_.landmark_residual(neighbour) -= block.transpose() * dm;
   }
-  return L.squared_pivots();
 }
 
 /// A test of membership in `slots` in O(1) without hashing: the slots get this call's mark.
@@ -540,7 +581,8 @@ void SeifSlam<Motion, Sensor>::relocalize(const std::vector<MeasurementInformati
   for (std::size_t slot : touched)
     if (in_block.insert(slot).second) block.push_back(slot);
   Eigen::VectorXd squared_pivots;
-  for (int sweep = 0; sweep < std::max(options_.mean_recovery_sweeps, 1); ++sweep) squared_pivots = recover_mean_of_block(block);
+  for (int sweep = 0; sweep < std::max(options_.mean_recovery_sweeps, 1); ++sweep)
+    squared_pivots = recover_mean_of_block(block, active_queue_.size(), false);
   require_factorizable_after_update(squared_pivots, std::nullopt);
 }
 
