@@ -17,7 +17,7 @@ struct MotionWithoutSpace {
   using State = Eigen::Vector2d;
   using Control = Eigen::Vector2d;
   static constexpr int kDim = 2;
-  MotionPrediction<State, 2> predict(const State&, const Control&, double) const { return {}; }
+  MotionPrediction<State, kDim> predict(const State&, const Control&, double) const { return {}; }
 };
 static_assert(!MotionModel<MotionWithoutSpace>);
 

@@ -94,6 +94,7 @@ class ClosedFormLandmarks {
   /// not positive definite (nor then is D). O((M n)^3) for n of them.
   void squared_pivots_after_robot(Eigen::Ref<const Eigen::MatrixXd> D, Eigen::VectorXd& pivots) const {
     const auto n = static_cast<Eigen::Index>(positions_.size());
+    if (n == 0) return;
     Eigen::MatrixXd links(X, M * n);  // Omega_xU
     for (Eigen::Index u = 0; u < n; ++u)
       links.template middleCols<M>(M * u) = D.template block<M, X>(positions_[u], 0).transpose();

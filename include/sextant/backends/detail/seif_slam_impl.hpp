@@ -68,7 +68,8 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   }
   const Eigen::Matrix<double, X, 1> r_x = G_inv_T * info_.robot_residual();
   auto change = factor_workspace_.view(Phi_xA.cols());  // -Phi_Ax T Phi_xA on the active pairs: its upper triangle
-  change.template triangularView<Eigen::Upper>() = -Phi_xA.transpose() * (T * Phi_xA);
+  if (!active.empty())  // Eigen's triangular product binds a reference to the data of an empty matrix
+    change.template triangularView<Eigen::Upper>() = -Phi_xA.transpose() * (T * Phi_xA);
   auto at = [](std::size_t a) { return M * static_cast<Eigen::Index>(a); };
 
   atomically([&] {
@@ -376,7 +377,7 @@ void SeifSlam<Motion, Sensor>::fill_robot_and_diagonal_blocks(const std::vector<
 /// to the robot alone (the ones this update added) are eliminated first, in closed form: their rows
 /// hold only their diagonal block W_u and their robot link, so eliminating them changes only the
 /// robot's block, to Omega_xx - sum_u Omega_xu W_u^-1 Omega_ux, and the dense factorization works on
-/// the rest (at the thesis's scale ~700 of ~790 dimensions: a third fewer flops). Returns squared
+/// the rest (at the thesis's scale ~670 of ~760 dimensions: a third fewer flops). Returns squared
 /// pivots, one per dimension of B in B's order, of a factorization of the block that
 /// require_factorizable_after_update checks, (robot, the first `leading` slots) after this update:
 /// ordered (closed-form landmarks, robot, the rest) as computed when no sparsification follows;
