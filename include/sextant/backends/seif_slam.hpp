@@ -241,8 +241,7 @@ class SeifSlam {
   void gather_links_below(const std::vector<std::size_t>& slots, std::size_t a, Eigen::Ref<Eigen::MatrixXd> D,
                           std::size_t first) const;
   void fill_robot_and_diagonal_blocks(const std::vector<std::size_t>& slots, Eigen::Ref<Eigen::MatrixXd> D) const;
-  void require_factorizable_block(const std::vector<std::size_t>& slots, Eigen::Ref<Eigen::MatrixXd> D,
-                                  const char* what) const;
+  static void require_factorizable_block(Eigen::Ref<Eigen::MatrixXd> D, const char* what);
   /// A predicate true for exactly the given slots, valid until the next call.
   auto mark_slots(const std::vector<std::size_t>& slots);
   void update_active_queue(const std::vector<std::size_t>& observed_slots);

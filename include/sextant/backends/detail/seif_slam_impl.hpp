@@ -92,7 +92,8 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
         });
     x_ = prediction.x;
     require_finite_robot_and_active("SEIF motion update");
-    require_factorizable_block(active, D, "SEIF motion update");
+    fill_robot_and_diagonal_blocks(active, D);
+    require_factorizable_block(D, "SEIF motion update");
   });
   propagated_ = prediction.x;
 }
@@ -292,16 +293,14 @@ void SeifSlam<Motion, Sensor>::require_factorizable_robot_and_active(const char*
   std::vector<std::size_t> slots;
   for (const auto& [slot, block] : info_.robot_links()) slots.push_back(slot);
   auto D = block_workspace_.view(X + M * static_cast<Eigen::Index>(slots.size()));
-  for (std::size_t a = 0; a < slots.size(); ++a) gather_links_below(slots, a, D, a + 1);
-  require_factorizable_block(slots, D, what);
+  robot_and_landmarks_block(slots, D);
+  require_factorizable_block(D, what);
 }
 
-/// require_factorizable_robot_and_active's test on D, whose links below the diagonal blocks hold
-/// Omega over (robot, slots...) already: D is completed and factorized (overwritten).
+/// require_factorizable_robot_and_active's test on D, the (robot, active) block as
+/// robot_and_landmarks_block writes it; D is factorized (overwritten).
 template <class Motion, class Sensor>
-void SeifSlam<Motion, Sensor>::require_factorizable_block(const std::vector<std::size_t>& slots,
-                                                         Eigen::Ref<Eigen::MatrixXd> D, const char* what) const {
-  fill_robot_and_diagonal_blocks(slots, D);
+void SeifSlam<Motion, Sensor>::require_factorizable_block(Eigen::Ref<Eigen::MatrixXd> D, const char* what) {
   require_well_conditioned_in_place(D, std::string(what) + ": the information of the robot and the active landmarks");
 }
 
