@@ -135,6 +135,20 @@ void BM_GlobeSeif120Steps(benchmark::State& state) {
   state.counters["active"] = static_cast<double>(state.range(0));
 }
 
+/// SEIF with relocalization (ESEIF, the consistent sparsification; the camera's velocities relocalized
+/// with the prior's covariance) and 150 or 250 active landmarks; `relocalizations` counts the steps
+/// that relocalized.
+void BM_GlobeRelocalizingSeif120Steps(benchmark::State& state) {
+  const auto& data = real_scale_globe();
+  for (auto _ : state) {
+    Seif seif(data.motion, data.sensor, data.prior,
+              {.max_active = static_cast<std::size_t>(state.range(0)), .sparsification = SeifSparsification::relocalization});
+    run_timed(seif, state);
+    state.counters["relocalizations"] = static_cast<double>(seif.relocalizations());
+  }
+  state.counters["active"] = static_cast<double>(state.range(0));
+}
+
 /// GraphSLAM online (GraphOptions::incremental): one Gauss-Newton step a frame on the incrementally
 /// factorized reduced pose system. Counters as the filters' (median, 95th percentile, last step),
 /// and global_update_s: one batch Gauss-Newton iteration over the same graph right after the run,
@@ -239,6 +253,7 @@ void BM_GlobeEkfUpdateAtFinalSize(benchmark::State& state) {
 BENCHMARK(BM_GlobeEkf120Steps)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GlobeEkfUpdateAtFinalSize)->Iterations(3)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GlobeSeif120Steps)->Arg(150)->Arg(250)->Arg(1000)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK(BM_GlobeRelocalizingSeif120Steps)->Arg(150)->Arg(250)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GlobeGraphOnline120Steps)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GlobeGraphOneGlobalUpdate)->Iterations(3)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GlobeGraphMarginals)

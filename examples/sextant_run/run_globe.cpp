@@ -151,13 +151,21 @@ std::vector<BackendChoice> globe_choices(const std::vector<BackendKind>& kinds, 
   std::vector<BackendChoice> choices;
   for (auto choice : backend_choices<Motion>(kinds, c)) {
     if (choice.kind == BackendKind::seif) {
-      for (std::size_t active : c.globe.seif_active) {
+      const auto add = [&](BackendChoice seif, std::size_t active) {
+        const bool relocalizing = seif.seif.sparsification == SeifSparsification::relocalization;
         const std::string name = active ? std::to_string(active) : "all";
-        choice.seif.max_active = active;
-        choice.key = "seif" + name;
-        choice.label = "SEIF-SLAM, " + name + " active";
-        choices.push_back(choice);
-      }
+        seif.seif.max_active = active;
+        seif.seif.estimate = use_estimate(c.seif_estimate, seif.seif.sparsification);
+        seif.key = (relocalizing ? "eseif" : "seif") + name;
+        seif.label = (relocalizing ? "ESEIF-SLAM, " : "SEIF-SLAM, ") + name + " active";
+        choices.push_back(std::move(seif));
+      };
+      for (std::size_t active : c.globe.seif_active) add(choice, active);
+      choice.seif.sparsification = SeifSparsification::relocalization;
+      for (std::size_t active : c.globe.eseif_active)
+        if (choice.seif.sparsification != c.seif.sparsification ||
+            std::find(c.globe.seif_active.begin(), c.globe.seif_active.end(), active) == c.globe.seif_active.end())
+          add(choice, active);  // not twice when [seif] sparsification relocalizes already
       continue;
     }
     if (choice.kind == BackendKind::graph) {

@@ -48,6 +48,9 @@ struct GlobeSettings {
   double response_jitter = 0.0;   ///< the detector's frame-to-frame response noise (sim::GlobeCameraOptions)
   PoolLimits pool{.max_landmarks = 1000, .max_new_per_step = 50};  ///< thesis: Mmax = 1000, 50 new per step
   std::vector<std::size_t> seif_active{150, 250, 0};  ///< one SEIF run per value (0 = all active)
+  /// One more SEIF run per value with relocalization (ESEIF, the consistent sparsification), whatever
+  /// [seif] sparsification says; empty = none.
+  std::vector<std::size_t> eseif_active{150, 250};
   std::size_t covariance_period = 10;  ///< pose NEES every this many steps
   int graph_updates = 10;              ///< GraphSLAM global updates after the windowed initialization
   bool graph_batch = true;             ///< [globe] graph: the thesis's batch GraphSLAM row
@@ -187,6 +190,17 @@ inline double parse_gate_probability(const std::string& text) {
   return p;
 }
 
+/// A list of active-landmark counts ("150 250 0"); with `relocalizing`, counts of at least 1 or
+/// "none" (an empty list).
+inline std::vector<std::size_t> parse_active_counts(const std::string& text, bool relocalizing) {
+  if (relocalizing && text == "none") return {};
+  std::istringstream in(text);
+  std::vector<std::size_t> values;
+  for (std::string word; in >> word;) values.push_back(parse_integer<std::size_t>(word, relocalizing ? 1 : 0, 1e6));
+  if (values.empty()) throw invalid_input_error("'" + text + "' lists no value");
+  return values;
+}
+
 template <class Enum>
 Enum parse_choice(const std::string& text, std::initializer_list<std::pair<const char*, Enum>> choices) {
   std::string names;
@@ -235,13 +249,11 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"globe", "max_new_per_step", "50", "new landmarks per step at most (thesis: 50)",
        [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_new_per_step = parse_integer<std::size_t>(v, 1, 1e6); }},
       {"globe", "seif_active", "150 250 0", "SEIF runs, one per value: active landmarks (0 = all)",
-       [](RunnerConfig& c, const std::string& v) {
-         std::istringstream in(v);
-         std::vector<std::size_t> values;
-         for (std::string word; in >> word;) values.push_back(parse_integer<std::size_t>(word, 0, 1e6));
-         if (values.empty()) throw invalid_input_error("'" + v + "' lists no value");
-         c.globe.seif_active = values;
-       }},
+       [](RunnerConfig& c, const std::string& v) { c.globe.seif_active = parse_active_counts(v, false); }},
+      {"globe", "eseif_active", "150 250",
+       "SEIF runs with relocalization (ESEIF, consistent; docs/results/seif_relocalization.md), one per value: "
+       "active landmarks (at least 1); 'none' = no such run",
+       [](RunnerConfig& c, const std::string& v) { c.globe.eseif_active = parse_active_counts(v, true); }},
       {"globe", "covariance_period", "10", "NEES of the pose every this many steps (a SEIF's covariance costs a factorization)",
        [](RunnerConfig& c, const std::string& v) { c.globe.covariance_period = parse_integer<std::size_t>(v, 1); }},
       {"globe", "tracker", "ekf",
@@ -402,7 +414,8 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"seif", "sparsification", "thesis",
        "thesis (eqs. 37-44: drops the links, overconfident) | relocalization (ESEIF: marginalizes the robot and "
        "relocalizes it from held-back measurements, conservative; needs measurements that determine the robot "
-       "state, so not the globe or VI-SLAM; docs/results/seif_relocalization.md)",
+       "state but for a tail the motion model declares unseen, such as the globe camera's velocities, which are "
+       "relocalized with the prior's covariance; docs/results/seif_relocalization.md)",
        [](RunnerConfig& c, const std::string& v) {
          c.seif.sparsification = parse_choice<SeifSparsification>(
              v, {{"thesis", SeifSparsification::thesis}, {"relocalization", SeifSparsification::relocalization}});

@@ -11,6 +11,7 @@
 #include "sextant/models/stereo_imu_se3.hpp"
 #include "sextant/sim/ship_2d.hpp"
 #include "support/batch_least_squares.hpp"
+#include "support/constant_velocity_point.hpp"
 
 namespace sextant {
 namespace {
@@ -150,56 +151,11 @@ TEST(FastSlam, VersionTwoReportsTheMixtureOfItsProposalsNotItsDraws) {
 
 INSTANTIATE_TEST_SUITE_P(BothVersions, FastVersions, ::testing::Values(FastSlamVersion::v1, FastSlamVersion::v2));
 
-/// A point moving at a nearly constant velocity in the plane, state (p, v) with white-acceleration
-/// noise of density q, seeing the offsets m - p of landmarks: linear and Gaussian, so the Kalman
-/// filter (our EKF) is exact, and v is a conditionally linear tail.
-struct ConstantVelocityPoint {
-  using State = Eigen::Vector4d;
-  using Control = Eigen::Matrix<double, 0, 1>;
-  using Space = EuclideanSpace<4>;
-  static constexpr int kDim = 4;
-  static constexpr int kConditionallyLinearDims = 2;
-  double q = 0.02;
-  MotionPrediction<State, 4> predict(const State& x, const Control& /*u*/, double dt) const {
-    MotionPrediction<State, 4> out;
-    out.J_x_x.setIdentity();
-    out.J_x_x.topRightCorner<2, 2>() = dt * Eigen::Matrix2d::Identity();
-    out.x = out.J_x_x * x;
-    out.R.setZero();
-    out.R.topLeftCorner<2, 2>() = q * dt * dt * dt / 3.0 * Eigen::Matrix2d::Identity();
-    out.R.topRightCorner<2, 2>() = out.R.bottomLeftCorner<2, 2>() = q * dt * dt / 2.0 * Eigen::Matrix2d::Identity();
-    out.R.bottomRightCorner<2, 2>() = q * dt * Eigen::Matrix2d::Identity();
-    return out;
-  }
-};
-struct PointOffset {
-  using Landmark = Eigen::Vector2d;
-  using Measurement = Eigen::Vector2d;
-  double sigma = 0.05;
-  MeasurementPrediction<2, 4, 2> predict(const Eigen::Vector4d& x, const Landmark& m) const {
-    MeasurementPrediction<2, 4, 2> out;
-    out.z = m - x.head<2>();
-    out.J_z_x << -Eigen::Matrix2d::Identity(), Eigen::Matrix2d::Zero();
-    out.J_z_m.setIdentity();
-    out.Q = sigma * sigma * Eigen::Matrix2d::Identity();
-    return out;
-  }
-  Measurement residual(const Measurement& z, const Measurement& z_hat) const { return z - z_hat; }
-  LandmarkInit<2, 4, 2> initialize(const Eigen::Vector4d& x, const Measurement& z) const {
-    LandmarkInit<2, 4, 2> out;
-    out.m = x.head<2>() + z;
-    out.J_m_x << Eigen::Matrix2d::Identity(), Eigen::Matrix2d::Zero();
-    out.J_m_z.setIdentity();
-    out.Q = sigma * sigma * Eigen::Matrix2d::Identity();
-    return out;
-  }
-};
-
 /// Squared distance of FastSLAM 2.0's velocity estimate (30 particles) from the exact Kalman
 /// filter's, summed over 40 steps of a linear world, for one seed and one treatment of the tail.
 double squared_velocity_gap(FastSlamLinearTail tail, std::uint64_t seed, bool check_particles) {
-  const ConstantVelocityPoint motion;
-  const PointOffset sensor;
+  const test::ConstantVelocityPoint motion;
+  const test::PointOffset sensor;
   const Gaussian<Eigen::Vector4d, 4> prior{Eigen::Vector4d(0, 0, 1, 0.5),
                                            Eigen::Vector4d(1e-4, 1e-4, 0.25, 0.25).asDiagonal().toDenseMatrix()};
   std::mt19937_64 rng(seed);
@@ -207,9 +163,9 @@ double squared_velocity_gap(FastSlamLinearTail tail, std::uint64_t seed, bool ch
   Eigen::Vector4d truth = prior.mean + Eigen::Vector4d(0.01 * unit(rng), 0.01 * unit(rng), 0.5 * unit(rng), 0.5 * unit(rng));
   std::vector<Eigen::Vector2d> landmarks;
   for (int j = 0; j < 5; ++j) landmarks.emplace_back(4.0 * unit(rng), 4.0 * unit(rng));
-  FastSlam<ConstantVelocityPoint, PointOffset> fast{motion, sensor, prior,
+  FastSlam<test::ConstantVelocityPoint, test::PointOffset> fast{motion, sensor, prior,
                                                     {.particles = 30, .seed = seed, .linear_tail = tail}};
-  EkfSlam<ConstantVelocityPoint, PointOffset> kalman{motion, sensor, prior};
+  EkfSlam<test::ConstantVelocityPoint, test::PointOffset> kalman{motion, sensor, prior};
   double gap = 0.0;
   const double dt = 0.1;
   for (int k = 0; k < 40; ++k) {

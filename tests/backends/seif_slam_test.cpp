@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <random>
 #include <set>
 #include <limits>
 
@@ -18,6 +19,7 @@
 #include "sextant/sim/globe_camera.hpp"
 #include "sextant/sim/ship_2d.hpp"
 #include "support/batch_least_squares.hpp"
+#include "support/constant_velocity_point.hpp"
 #include "support/seif_sparsification_reference.hpp"
 
 namespace sextant {
@@ -26,6 +28,15 @@ namespace {
 using Seif = SeifSlam<BeaconShip2D, BeaconOffset2D>;
 using Ekf = EkfSlam<BeaconShip2D, BeaconOffset2D>;
 static_assert(SlamBackend<Seif>);
+
+/// One step of two filters run side by side on the same data.
+template <class A, class B, class Step>
+void step_both(A& a, B& b, const Step& step) {
+  a.predict(step.control, step.dt);
+  b.predict(step.control, step.dt);
+  a.update(step.observations);
+  b.update(step.observations);
+}
 
 double max_relative_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a - b).cwiseAbs().maxCoeff() / std::max(1e-300, b.cwiseAbs().maxCoeff());
@@ -37,11 +48,7 @@ TEST(SeifSlam, WithoutSparsificationEqualsEkfOverTheWholeShipRun) {
   Seif seif{data.motion, data.sensor, data.prior, {.max_active = 0, .exact_recovery_period = 1}};
   double worst_mean = 0.0, worst_cov = 0.0;
   for (std::size_t k = 0; k < data.steps.size(); ++k) {
-    const auto& step = data.steps[k];
-    ekf.predict(step.control, step.dt);
-    seif.predict(step.control, step.dt);
-    ekf.update(step.observations);
-    seif.update(step.observations);
+    step_both(ekf, seif, data.steps[k]);
     const auto e = ekf.pose(), s = seif.pose();
     worst_mean = std::max(worst_mean, (e.mean - s.mean).cwiseAbs().maxCoeff());
     worst_cov = std::max(worst_cov, max_relative_difference(s.cov, e.cov));
@@ -216,11 +223,108 @@ TEST(SeifSlam, TheExactMeanEstimateIsTheMeanAnExactRecoveryMovesTo) {
   }
 }
 
-TEST(SeifSlam, RelocalizationRefusesAStateNoMeasurementDetermines) {
+TEST(SeifSlam, RelocalizationNamesATailCovarianceOfTheWrongSizeOrNotPositiveDefinite) {
   const auto data = sim::simulate_globe_camera({.num_steps = 2});
-  EXPECT_THROW((SeifSlam<EulerCamera12D, PointInCamera3D>{data.motion, data.sensor, data.prior,
-                                                          {.max_active = 10, .sparsification = SeifSparsification::relocalization}}),
+  using Camera = SeifSlam<EulerCamera12D, PointInCamera3D>;
+  SeifOptions options{.max_active = 10, .sparsification = SeifSparsification::relocalization};
+  EXPECT_NO_THROW((Camera{data.motion, data.sensor, data.prior, options}));  // the prior's tail covariance
+  const auto message_of = [&](const Eigen::MatrixXd& tail) {
+    options.relocalization_tail_covariance = tail;
+    try {
+      Camera{data.motion, data.sensor, data.prior, options};
+    } catch (const invalid_input_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message_of(Eigen::MatrixXd::Identity(12, 12)).find("must be 6 x 6"), std::string::npos);
+  EXPECT_NE(message_of(-Eigen::MatrixXd::Identity(6, 6)).find("relocalization tail covariance"), std::string::npos);
+  Eigen::MatrixXd nan = Eigen::MatrixXd::Identity(6, 6);
+  nan(2, 3) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(message_of(nan).find("NaN"), std::string::npos);
+  const auto ship = sim::simulate_ship_2d({.num_steps = 2});  // no unseen tail: none to give
+  EXPECT_THROW((Seif{ship.motion, ship.sensor, ship.prior,
+                     {.max_active = 2, .sparsification = SeifSparsification::relocalization,
+                      .relocalization_tail_covariance = Eigen::MatrixXd::Identity(2, 2)}}),
                invalid_input_error);
+}
+
+/// Relocalization of a robot whose velocity no measurement sees (docs/derivations/seif_relocalization.md):
+/// each relocalization gives the velocity the information Lambda of its tail covariance, which the
+/// exact posterior does not hold, and discards the rest of the robot's (the odometry chain). On a
+/// linear world the relocalized filter's joint covariance of the robot and the map is therefore at
+/// most overconfident by the factor 1 + sum_k lambda_max(Sigma_vv(k) Lambda), Sigma_vv(k) the exact
+/// filter's velocity covariance at relocalization k (the EKF, the exact posterior, in the same loop):
+/// no direction's variance falls below the exact one divided by that factor.
+TEST(SeifSlam, RelocalizingAnUnseenTailIsOverconfidentAtMostByTheShareOfItsPrior) {
+  using World = test::ConstantVelocityPoint;
+  const World motion;
+  const test::PointOffset sensor;
+  const Gaussian<Eigen::Vector4d, 4> prior{Eigen::Vector4d(0, 0, 1, 0.5),
+                                           Eigen::Vector4d(1e-4, 1e-4, 0.25, 0.25).asDiagonal().toDenseMatrix()};
+  const Eigen::Matrix2d tail_covariance = 25.0 * Eigen::Matrix2d::Identity();
+  const Eigen::Matrix2d tail_information = tail_covariance.inverse();
+  EkfSlam<World, test::PointOffset> exact{motion, sensor, prior};
+  SeifSlam<World, test::PointOffset> seif{motion, sensor, prior,
+                                          {.max_active = 2, .sparsification = SeifSparsification::relocalization,
+                                           .relocalization_tail_covariance = tail_covariance}};
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::vector<Eigen::Vector2d> landmarks;
+  for (int j = 0; j < 6; ++j) landmarks.emplace_back(4.0 * unit(rng), 4.0 * unit(rng));
+  Eigen::Vector4d truth = prior.mean;
+  double bound = 1.0, worst = 0.0;
+  const double dt = 0.1;
+  for (int k = 0; k < 80; ++k) {
+    if (k > 0) {
+      const auto p = motion.predict(truth, {}, dt);
+      truth = p.x + Eigen::LLT<Eigen::Matrix4d>(p.R).matrixL() * Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng));
+      exact.predict({}, dt);
+      seif.predict({}, dt);
+    }
+    std::vector<Observation<Eigen::Vector2d>> seen;
+    for (std::size_t j = 0; j < landmarks.size(); ++j)
+      seen.push_back({j, landmarks[j] - truth.head<2>() + sensor.sigma * Eigen::Vector2d(unit(rng), unit(rng))});
+    exact.update(seen);
+    const auto before = seif.relocalizations();
+    seif.update(seen);
+    if (seif.relocalizations() > before) {
+      const Eigen::Matrix2d velocity = exact.pose().cov.bottomRightCorner<2, 2>();
+      bound += Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d>(tail_information, velocity.inverse(),
+                                                                        Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+    }
+    const std::vector<LandmarkId> ids = exact.landmark_ids();
+    const Eigen::MatrixXd exact_cov = joint_covariance_of(exact, ids), seif_cov = joint_covariance_of(seif, ids);
+    // the largest d' Sigma_exact d / d' Sigma_seif d: how many times too small SEIF's variance is somewhere
+    const double ratio = Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd>(exact_cov, seif_cov, Eigen::EigenvaluesOnly)
+                             .eigenvalues().maxCoeff();
+    worst = std::max(worst, ratio);
+    EXPECT_LE(ratio, bound * (1.0 + 1e-9)) << "step " << k;
+  }
+  std::printf("%llu relocalizations; exact variance over SEIF's at most %.4f, bound %.4f\n",
+              static_cast<unsigned long long>(seif.relocalizations()), worst, bound);
+  EXPECT_GT(seif.relocalizations(), 40u);  // it relocalized at most steps (6 landmarks seen, 2 kept)
+  EXPECT_LT(bound, 1.1);                   // the bound says something: a 10% margin at most
+}
+
+/// The 12D camera relocalizes from its landmarks with its velocities from the prior's covariance,
+/// and stays with the EKF run beside it: the pose difference inside the bound of the two
+/// covariances together at every step (both filters err around the truth; a SEIF that lost the
+/// camera, or trusted itself too much, would leave it).
+TEST(SeifSlam, RelocalizationRunsOnTheCameraWhoseVelocitiesNoFrameSees) {
+  const auto data = sim::simulate_globe_camera({.seed = 2, .num_steps = 40});
+  EkfSlam<EulerCamera12D, PointInCamera3D> ekf{data.motion, data.sensor, data.prior};
+  SeifSlam<EulerCamera12D, PointInCamera3D> seif{
+      data.motion, data.sensor, data.prior, {.max_active = 60, .sparsification = SeifSparsification::relocalization}};
+  for (std::size_t k = 0; k < data.steps.size(); ++k) {
+    step_both(ekf, seif, data.steps[k]);
+    const auto e = ekf.pose(), s = seif.pose();
+    const Eigen::Matrix<double, 6, 1> gap = (s.mean - e.mean).head<6>();
+    EXPECT_LT(eval::nees(gap, Eigen::Matrix<double, 6, 6>((s.cov + e.cov).topLeftCorner<6, 6>())),
+              test::nees_bound(6, data.steps.size()))
+        << "step " << k;
+  }
+  EXPECT_GT(seif.relocalizations(), 5u);
 }
 
 TEST(SeifSlam, SparsificationOnARecordedRunEqualsTheThesisForm) {
@@ -307,10 +411,7 @@ FilterGap ekf_seif_gap_on_the_globe(bool constrained) {
       data.motion, data.sensor, data.prior, {.max_active = 0, .exact_recovery_period = 1, .observability_constraints = constrained}};
   FilterGap gap;
   for (const auto& step : data.steps) {
-    ekf.predict(step.control, step.dt);
-    seif.predict(step.control, step.dt);
-    ekf.update(step.observations);
-    seif.update(step.observations);
+    step_both(ekf, seif, step);
     const auto e = ekf.pose(), s = seif.pose();
     gap.mean = std::max(gap.mean, (e.mean - s.mean).cwiseAbs().maxCoeff());
     gap.cov = std::max(gap.cov, max_relative_difference(s.cov, e.cov));

@@ -97,11 +97,11 @@ TEST_F(RunnerCli, GlobeRunsEveryBackEndThroughThePoolAndWritesBookkeepingAndScen
   // A short globe with a small pool, so that eviction happens: one row per back-end configuration.
   const auto ini = dir / "globe.ini";
   std::ofstream(ini) << "[globe]\nsteps = 60\npoints = 800\nfeatures_per_frame = 40\nmax_landmarks = 45\n"
-                        "max_new_per_step = 10\nseif_active = 20 0\ngraph_updates = 2\n[fastslam]\nparticles = 10\n";
+                        "max_new_per_step = 10\nseif_active = 20 0\neseif_active = 20\ngraph_updates = 2\n[fastslam]\nparticles = 10\n";
   const auto out = dir / "out";
   const auto r = run_runner("--dataset globe --config " + ini.string() + " --out " + out.string(), dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const char* label : {"EKF-SLAM", "SEIF-SLAM, 20 active", "SEIF-SLAM, all active", "GraphSLAM, windows 50 x 5",
+  for (const char* label : {"EKF-SLAM", "SEIF-SLAM, 20 active", "ESEIF-SLAM, 20 active", "SEIF-SLAM, all active", "GraphSLAM, windows 50 x 5",
                             "FastSLAM 1.0", "FastSLAM 2.0", "after each global update", "ms per frame"})
     EXPECT_NE(r.out.find(label), std::string::npos) << label << " not in:\n" << r.out;
   EXPECT_EQ(r.out.find("nan"), std::string::npos) << "a score not computed must print as -:\n" << r.out;
@@ -256,6 +256,7 @@ TEST_F(RunnerCli, ConfigFilesThatAreNotSettingsAreRefused) {
   refused("[fastslam]\nparticles = 2000000000\n", {ini, "[fastslam] particles", "is not an integer in [1, 1000000]"});
   refused("[ship]\nsteps = 2000000000\n", {ini, "[ship] steps", "is not an integer in [1, 10000000]"});
   refused("[globe]\nseif_active = 150 2000000000\n", {ini, "[globe] seif_active", "is not an integer in [0, 1000000]"});
+  refused("[globe]\neseif_active = 0\n", {ini, "[globe] eseif_active", "is not an integer in [1, 1000000]"});
 
   // Random bytes: refused, and the message shows no raw byte.
   std::string bytes = "[ship]\nseed = 1\n";

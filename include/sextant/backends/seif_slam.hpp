@@ -50,8 +50,9 @@ enum class SeifSparsification {
   /// The exactly sparse filter of Walter, Eustice and Leonard (ESEIF): when the active set would
   /// overflow, the measurements of a few observed landmarks are held back, the robot is marginalized
   /// out after the others are applied, and a new robot state is relocalized from the held-back
-  /// ones. Only information is discarded (conservative); needs measurements that determine the whole
-  /// robot state.
+  /// ones. Only information is discarded (conservative). The measurements must determine the robot
+  /// state but a conditionally linear tail no measurement sees (the 12D camera's velocities), which
+  /// is relocalized from SeifOptions::relocalization_tail_covariance.
   relocalization,
 };
 
@@ -75,6 +76,14 @@ struct SeifOptions {
   /// 0.05 (at most 20x less information, 4.5x the standard deviation) is in
   /// docs/results/seif_relocalization.md.
   double relocalization_min_information = 0.05;
+  /// Relocalization of a robot whose motion model has a tail no measurement sees
+  /// (kConditionallyLinearDims = T, e.g. the 12D camera's velocities): the covariance (T x T) the
+  /// relocalized tail gets, centred at its current mean and linked to nothing. Empty (the default):
+  /// the prior's, the uncertainty the filter started with. The relocalized filter is then
+  /// overconfident by at most the factor 1 + lambda_max(Sigma_tt Sigma_tail^-1), Sigma_tt the tail's
+  /// exact marginal covariance (docs/derivations/seif_relocalization.md): a few percent where the
+  /// data have taught the filter the tail far better than the prior knew it.
+  Eigen::MatrixXd relocalization_tail_covariance;
   SeifEstimate estimate = SeifEstimate::recovered_mean;
   MeanRecovery mean_recovery = MeanRecovery::active_block;
   int mean_recovery_sweeps = 1;   ///< sweeps per update (0 = none)
@@ -166,6 +175,8 @@ class SeifSlam {
   const SeifOptions& options() const { return options_; }
   /// Stage times of the last update that succeeded (zeros before the first).
   const SeifUpdateTimes& last_update_times() const { return last_update_times_; }
+  /// Updates that relocalized the robot (SeifSparsification::relocalization) since construction.
+  std::uint64_t relocalizations() const { return relocalizations_; }
 
  private:
   using Linearized = LinearizedObservation<Z, X, M>;
@@ -252,6 +263,10 @@ class SeifSlam {
                                                                    std::size_t new_landmarks) const;
   /// Omega' = Omega_mm - Omega_mx Omega_xx^-1 Omega_xm and r' likewise, over the active landmarks
   /// only; leaves the robot with no information and no links.
+  /// The trailing entries of the robot state no measurement sees (core/conditionally_linear.hpp).
+  static constexpr int kUnseenTail = conditionally_linear_dims_v<Motion>;
+  Eigen::MatrixXd relocalized_tail_information(const PoseEstimate& prior) const;
+  std::optional<Eigen::Matrix<double, X - kUnseenTail, X - kUnseenTail>> seen_information_given_map() const;
   void marginalize_robot();
   void relocalize(const std::vector<MeasurementInformation>& held_back, std::vector<std::size_t> observed);
   /// The squared pivots of the Cholesky factor of S_xx when it sparsified. `active_block_gathered`:
@@ -273,6 +288,9 @@ class SeifSlam {
   Motion motion_;
   Sensor sensor_;
   SeifOptions options_;
+  /// The information a relocalized robot gets on the tail no measurement sees (T x T; empty when
+  /// T = 0 or without relocalization).
+  Eigen::MatrixXd tail_information_;
   InnovationGate gate_;
   State x_;
   State propagated_;  ///< the robot state after the last prediction (observability constraints)
@@ -281,6 +299,7 @@ class SeifSlam {
   SeifUpdateTimes last_update_times_;
   std::vector<std::size_t> active_queue_;  ///< slots linked to the robot, most recently observed first
   std::uint64_t updates_ = 0;
+  std::uint64_t relocalizations_ = 0;
   std::uint64_t revision_ = 0;
   Undo* undo_ = nullptr;  ///< the open transaction's undo record
   VersionedCache<Factor> factor_;  ///< factorization of Omega at revision_ (thread-safe)

@@ -31,10 +31,27 @@ SeifSlam<Motion, Sensor>::SeifSlam(Motion motion, Sensor sensor, const PoseEstim
   if (options_.mean_recovery_sweeps < 0 || options_.exact_recovery_period < 0)
     throw invalid_input_error("SeifOptions: mean_recovery_sweeps and exact_recovery_period must be >= 0");
   gate_ = InnovationGate(Z, options_.gate_probability);
-  if (options_.sparsification == SeifSparsification::relocalization && conditionally_linear_dims_v<Motion> > 0)
-    throw invalid_input_error("SeifOptions: relocalization needs measurements that determine the whole robot state, and "
-                              "no measurement sees the last " +
-                              std::to_string(conditionally_linear_dims_v<Motion>) + " entries of this model's state");
+  if (options_.sparsification == SeifSparsification::relocalization) tail_information_ = relocalized_tail_information(prior);
+}
+
+/// The information of the relocalized tail: SeifOptions::relocalization_tail_covariance inverted, or
+/// the prior's tail covariance; nothing when no tail is unseen. Throws invalid_input_error on a
+/// covariance of the wrong size or one that is not positive definite.
+template <class Motion, class Sensor>
+Eigen::MatrixXd SeifSlam<Motion, Sensor>::relocalized_tail_information(const PoseEstimate& prior) const {
+  constexpr int T = kUnseenTail;
+  const Eigen::MatrixXd& given = options_.relocalization_tail_covariance;
+  if (given.size() > 0 && (given.rows() != T || given.cols() != T))
+    throw invalid_input_error("SeifOptions: relocalization_tail_covariance must be " + std::to_string(T) + " x " +
+                              std::to_string(T) + " (the entries of the state no measurement sees), got " +
+                              std::to_string(given.rows()) + " x " + std::to_string(given.cols()));
+  if (T == 0) return {};
+  const Eigen::MatrixXd cov = given.size() > 0 ? given : Eigen::MatrixXd(prior.cov.bottomRightCorner(T, T));
+  if (!cov.allFinite()) throw invalid_input_error("SeifOptions: relocalization_tail_covariance contains NaN or Inf");
+  const Eigen::LLT<Eigen::MatrixXd> llt(symmetrized(cov));
+  if (llt.info() != Eigen::Success)
+    throw invalid_input_error("SeifOptions: relocalization tail covariance is not positive definite");
+  return symmetrized(Eigen::MatrixXd(llt.solve(Eigen::MatrixXd::Identity(T, T))));
 }
 
 /// Thesis eqs. (20)-(26) in error-state form, with Phi = G^-T Omega G^-1 and
@@ -212,6 +229,7 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
     times.sparsification_s = seconds_since(stage_start);
   });
   last_update_times_ = times;
+  if (!relocalization.empty()) ++relocalizations_;
   return result;
 }
 
@@ -523,16 +541,39 @@ auto SeifSlam<Motion, Sensor>::hold_back_for_relocalization(std::vector<Measurem
     std::swap(observations[k], observations[best]);
     chosen += observations[k].xx;
   }
-  // Lambda_beta v = lambda Omega_xx v: the share of the robot's information (given the map) that the
-  // held-back measurements carry, in the direction where they carry least.
-  const Eigen::GeneralizedSelfAdjointEigenSolver<MatrixX> relative(chosen, info_.robot(), Eigen::EigenvaluesOnly);
+  // Lambda_beta v = lambda Omega_ss v on the entries measurements see (s): the share of the robot's
+  // information given the map that the held-back measurements carry, where they carry least.
+  constexpr int P = X - kUnseenTail;
+  using MatrixP = Eigen::Matrix<double, P, P>;
+  const MatrixP seen = chosen.template topLeftCorner<P, P>();
+  const auto reference = seen_information_given_map();
+  if (!reference) return {};
+  const Eigen::GeneralizedSelfAdjointEigenSolver<MatrixP> relative(seen, *reference, Eigen::EigenvaluesOnly);
   if (!(relative.eigenvalues()(0) >= options_.relocalization_min_information)) return {};
-  const Eigen::SelfAdjointEigenSolver<MatrixX> eigen(chosen, Eigen::EigenvaluesOnly);
-  if (!(eigen.eigenvalues()(0) > 1e-9 * eigen.eigenvalues()(X - 1))) return {};
+  const Eigen::SelfAdjointEigenSolver<MatrixP> eigen(seen, Eigen::EigenvaluesOnly);
+  if (!(eigen.eigenvalues()(0) > 1e-9 * eigen.eigenvalues()(P - 1))) return {};
   const auto held_end = observations.begin() + static_cast<std::ptrdiff_t>(count);
   std::vector<MeasurementInformation> held(std::make_move_iterator(observations.begin()), std::make_move_iterator(held_end));
   observations.erase(observations.begin(), held_end);
   return held;
+}
+
+/// The information about the robot's seen entries given the map, Omega_ss; with an unseen tail t,
+/// marginal over it, Omega_ss - Omega_st Omega_tt^-1 Omega_ts: relocalization replaces the tail's
+/// information by its prior, and with it the pose information that came through it (the motion
+/// model's velocity). None when Omega_tt is not positive definite.
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::seen_information_given_map() const
+    -> std::optional<Eigen::Matrix<double, X - kUnseenTail, X - kUnseenTail>> {
+  constexpr int P = X - kUnseenTail, T = kUnseenTail;
+  const auto& omega = info_.robot();
+  Eigen::Matrix<double, P, P> out = omega.template topLeftCorner<P, P>();
+  if constexpr (T > 0) {
+    const Eigen::LLT<Eigen::Matrix<double, T, T>> tail(omega.template bottomRightCorner<T, T>());
+    if (tail.info() != Eigen::Success) return std::nullopt;
+    out -= omega.template topRightCorner<P, T>() * tail.solve(omega.template bottomLeftCorner<T, P>());
+  }
+  return symmetrized(out);
 }
 
 template <class Motion, class Sensor>
@@ -567,6 +608,8 @@ void SeifSlam<Motion, Sensor>::relocalize(const std::vector<MeasurementInformati
   std::vector<std::size_t> touched = active_queue_;
   touched.insert(touched.end(), observed.begin(), observed.end());
   marginalize_robot();
+  if constexpr (kUnseenTail > 0)  // centred at the current mean: no residual
+    info_.robot().template bottomRightCorner<kUnseenTail, kUnseenTail>() += tail_information_;
   for (const auto& info : held_back) {
     add(info);
     observed.insert(observed.begin(), info.slot);
