@@ -161,11 +161,12 @@ std::vector<BackendChoice> globe_choices(const std::vector<BackendKind>& kinds, 
         choices.push_back(std::move(seif));
       };
       for (std::size_t active : c.globe.seif_active) add(choice, active);
+      const bool seif_rows_relocalize = choice.seif.sparsification == SeifSparsification::relocalization;
       choice.seif.sparsification = SeifSparsification::relocalization;
-      for (std::size_t active : c.globe.eseif_active)
-        if (choice.seif.sparsification != c.seif.sparsification ||
-            std::find(c.globe.seif_active.begin(), c.globe.seif_active.end(), active) == c.globe.seif_active.end())
-          add(choice, active);  // not twice when [seif] sparsification relocalizes already
+      for (std::size_t active : c.globe.eseif_active) {
+        const bool listed = std::find(c.globe.seif_active.begin(), c.globe.seif_active.end(), active) != c.globe.seif_active.end();
+        if (!(seif_rows_relocalize && listed)) add(choice, active);  // a row once, not twice
+      }
       continue;
     }
     if (choice.kind == BackendKind::graph) {

@@ -170,15 +170,11 @@ double squared_velocity_gap(FastSlamLinearTail tail, std::uint64_t seed, bool ch
   const double dt = 0.1;
   for (int k = 0; k < 40; ++k) {
     if (k > 0) {
-      const auto p = motion.predict(truth, {}, dt);
-      const Eigen::LLT<Eigen::Matrix4d> noise(p.R);
-      truth = p.x + noise.matrixL() * Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng));
+      truth = test::moved(motion, truth, dt, rng, unit);
       fast.predict({}, dt);
       kalman.predict({}, dt);
     }
-    std::vector<Observation<Eigen::Vector2d>> seen;
-    for (std::size_t j = 0; j < landmarks.size(); ++j)
-      seen.push_back({j, landmarks[j] - truth.head<2>() + sensor.sigma * Eigen::Vector2d(unit(rng), unit(rng))});
+    const auto seen = test::sightings(landmarks, truth, sensor, rng, unit);
     fast.update(seen);
     kalman.update(seen);
     gap += (fast.pose().mean.tail<2>() - kalman.pose().mean.tail<2>()).squaredNorm();

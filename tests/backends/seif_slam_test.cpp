@@ -277,14 +277,11 @@ TEST(SeifSlam, RelocalizingAnUnseenTailIsOverconfidentAtMostByTheShareOfItsPrior
   const double dt = 0.1;
   for (int k = 0; k < 80; ++k) {
     if (k > 0) {
-      const auto p = motion.predict(truth, {}, dt);
-      truth = p.x + Eigen::LLT<Eigen::Matrix4d>(p.R).matrixL() * Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng));
+      truth = test::moved(motion, truth, dt, rng, unit);
       exact.predict({}, dt);
       seif.predict({}, dt);
     }
-    std::vector<Observation<Eigen::Vector2d>> seen;
-    for (std::size_t j = 0; j < landmarks.size(); ++j)
-      seen.push_back({j, landmarks[j] - truth.head<2>() + sensor.sigma * Eigen::Vector2d(unit(rng), unit(rng))});
+    const auto seen = test::sightings(landmarks, truth, sensor, rng, unit);
     exact.update(seen);
     const auto before = seif.relocalizations();
     seif.update(seen);

@@ -2,9 +2,13 @@
 // A linear-Gaussian world with a conditionally linear tail (core/conditionally_linear.hpp): the
 // Kalman filter (the library's EKF) is its exact posterior, against which FastSLAM's Rao-Blackwellized
 // tail and SEIF's relocalization of an unseen tail are checked.
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <random>
+#include <vector>
 
 #include "sextant/core/model_results.hpp"
+#include "sextant/core/observation.hpp"
 #include "sextant/core/state_space.hpp"
 
 namespace sextant::test {
@@ -53,5 +57,23 @@ struct PointOffset {
     return out;
   }
 };
+
+/// The true state dt after x: the model's mean plus a draw of its noise (four draws of `unit`).
+inline Eigen::Vector4d moved(const ConstantVelocityPoint& motion, const Eigen::Vector4d& x, double dt, std::mt19937_64& rng,
+                             std::normal_distribution<double>& unit) {
+  const auto p = motion.predict(x, {}, dt);
+  const Eigen::LLT<Eigen::Matrix4d> noise(p.R);
+  return p.x + noise.matrixL() * Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng));
+}
+
+/// Every landmark seen from the true state, id = its index, with the sensor's noise.
+inline std::vector<Observation<Eigen::Vector2d>> sightings(const std::vector<Eigen::Vector2d>& landmarks,
+                                                           const Eigen::Vector4d& truth, const PointOffset& sensor,
+                                                           std::mt19937_64& rng, std::normal_distribution<double>& unit) {
+  std::vector<Observation<Eigen::Vector2d>> seen;
+  for (std::size_t j = 0; j < landmarks.size(); ++j)
+    seen.push_back({j, landmarks[j] - truth.head<2>() + sensor.sigma * Eigen::Vector2d(unit(rng), unit(rng))});
+  return seen;
+}
 
 }  // namespace sextant::test

@@ -80,9 +80,10 @@ struct SeifOptions {
   /// (kConditionallyLinearDims = T, e.g. the 12D camera's velocities): the covariance (T x T) the
   /// relocalized tail gets, centred at its current mean and linked to nothing. Empty (the default):
   /// the prior's, the uncertainty the filter started with. The relocalized filter is then
-  /// overconfident by at most the factor 1 + lambda_max(Sigma_tt Sigma_tail^-1), Sigma_tt the tail's
-  /// exact marginal covariance (docs/derivations/seif_relocalization.md): a few percent where the
-  /// data have taught the filter the tail far better than the prior knew it.
+  /// overconfident by at most the factor 1 + sum over relocalizations k of
+  /// lambda_max(Sigma_tt(k) Sigma_tail^-1), Sigma_tt(k) the tail's exact marginal covariance then
+  /// (docs/derivations/seif_relocalization.md): small where the data have taught the filter the
+  /// tail far better than the prior knew it.
   Eigen::MatrixXd relocalization_tail_covariance;
   SeifEstimate estimate = SeifEstimate::recovered_mean;
   MeanRecovery mean_recovery = MeanRecovery::active_block;
@@ -261,12 +262,12 @@ class SeifSlam {
   /// determine the robot state (else none: the active set overflows until a step can relocalize).
   std::vector<MeasurementInformation> hold_back_for_relocalization(std::vector<MeasurementInformation>& observations,
                                                                    std::size_t new_landmarks) const;
-  /// Omega' = Omega_mm - Omega_mx Omega_xx^-1 Omega_xm and r' likewise, over the active landmarks
-  /// only; leaves the robot with no information and no links.
   /// The trailing entries of the robot state no measurement sees (core/conditionally_linear.hpp).
   static constexpr int kUnseenTail = conditionally_linear_dims_v<Motion>;
   Eigen::MatrixXd relocalized_tail_information(const PoseEstimate& prior) const;
   std::optional<Eigen::Matrix<double, X - kUnseenTail, X - kUnseenTail>> seen_information_given_map() const;
+  /// Omega' = Omega_mm - Omega_mx Omega_xx^-1 Omega_xm and r' likewise, over the active landmarks
+  /// only; leaves the robot with no information and no links.
   void marginalize_robot();
   void relocalize(const std::vector<MeasurementInformation>& held_back, std::vector<std::size_t> observed);
   /// The squared pivots of the Cholesky factor of S_xx when it sparsified. `active_block_gathered`:
