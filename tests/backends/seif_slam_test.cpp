@@ -208,6 +208,28 @@ TEST(SeifSlam, RelocalizationWithoutOverflowIsTheThesisFilterBitForBit) {
   EXPECT_EQ(Eigen::MatrixXd(thesis.information_matrix()), Eigen::MatrixXd(relocalizing.information_matrix()));
 }
 
+/// Which measurements relocalize the robot: those of landmarks the map knows. A landmark seen once is
+/// known only relative to the robot that saw it, so seeing it again says little about where the
+/// robot is, however precise the measurement. On the linear ship every measurement carries the same
+/// information given the map (H_x = -I, one Q), and the landmark seen once comes first in the frame:
+/// given the map it would be held back first.
+TEST(SeifSlam, RelocalizationHoldsBackTheLandmarksTheMapKnowsNotOneSeenOnce) {
+  const BeaconShip2D motion;
+  const BeaconOffset2D sensor;
+  Seif seif{motion, sensor, test::kLinearPrior,
+            {.max_active = 2, .sparsification = SeifSparsification::relocalization, .relocalization_min_information = 0.0}};
+  const Eigen::Vector2d x = test::kLinearPrior.mean;
+  const auto seen = [&](LandmarkId id, Eigen::Vector2d m) { return Observation<Eigen::Vector2d>{id, m - x}; };
+  const Eigen::Vector2d far_1(10, 0), far_2(0, 10), near(1, 1);
+  for (int k = 0; k < 5; ++k) seif.update(std::vector{seen(1, far_1), seen(2, far_2)});
+  seif.update(std::vector{seen(1, far_1), seen(2, far_2), seen(3, near)});  // 3 is new: 1 and 2 relocalize
+  ASSERT_EQ(seif.relocalizations(), 1u);
+  seif.update(std::vector{seen(3, near), seen(1, far_1), seen(2, far_2)});
+  ASSERT_EQ(seif.relocalizations(), 2u);
+  const auto active = seif.active_landmarks();
+  EXPECT_EQ(std::set<LandmarkId>(active.begin(), active.end()), (std::set<LandmarkId>{1, 2}));
+}
+
 TEST(SeifSlam, TheExactMeanEstimateIsTheMeanAnExactRecoveryMovesTo) {
   const auto data = sim::simulate_ship_2d({.seed = 3, .num_steps = 200});
   for (auto sparsification : {SeifSparsification::thesis, SeifSparsification::relocalization}) {

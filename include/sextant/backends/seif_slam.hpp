@@ -69,12 +69,12 @@ enum class SeifEstimate {
 struct SeifOptions {
   std::size_t max_active = 0;     ///< landmarks kept linked to the robot by sparsification; 0 = no sparsification
   SeifSparsification sparsification = SeifSparsification::thesis;
-  /// Relocalization only: the held-back measurements must carry at least this share of the robot's
-  /// information given the map (Omega_xx) in every direction, else the step does not sparsify and
-  /// the active set stays over max_active until one can. A pose relocalized from two landmarks 0.2 m
-  /// apart seen from 5 m has a heading the next linearizations cannot trust; the sweep that chose
-  /// 0.05 (at most 20x less information, 4.5x the standard deviation) is in
-  /// docs/results/seif_relocalization.md.
+  /// Relocalization only: the held-back measurements, their landmarks' uncertainty counted, must
+  /// carry at least this share of the robot's information given the map (Omega_xx) in every
+  /// direction, else the step does not sparsify and the active set stays over max_active until one
+  /// can. A pose relocalized from two landmarks 0.2 m apart seen from 5 m has a heading the next
+  /// linearizations cannot trust; the sweep that chose 0.05 (at most 20x less information, 4.5x the
+  /// standard deviation) is in docs/results/seif_relocalization.md.
   double relocalization_min_information = 0.05;
   /// Relocalization of a robot whose motion model has a tail no measurement sees
   /// (kConditionallyLinearDims = T, e.g. the 12D camera's velocities): the covariance (T x T) the
@@ -262,6 +262,7 @@ class SeifSlam {
   /// determine the robot state (else none: the active set overflows until a step can relocalize).
   std::vector<MeasurementInformation> hold_back_for_relocalization(std::vector<MeasurementInformation>& observations,
                                                                    std::size_t new_landmarks) const;
+  std::vector<Eigen::Matrix<double, X, X>> information_about_robot(const std::vector<MeasurementInformation>& observations) const;
   /// The trailing entries of the robot state no measurement sees (core/conditionally_linear.hpp).
   static constexpr int kUnseenTail = conditionally_linear_dims_v<Motion>;
   Eigen::MatrixXd relocalized_tail_information(const PoseEstimate& prior) const;

@@ -510,13 +510,14 @@ void SeifSlam<Motion, Sensor>::recover_mean_exactly_in_transaction() {
 }
 
 /// Which observed landmarks relocalize the robot (ESEIF): up to max_active of them (the new active
-/// set), chosen greedily for the most information about the robot (largest log det of
-/// Lambda = sum H_x^T Q^-1 H_x, D-optimal), provided Lambda holds at least
+/// set), chosen greedily for the most information about the robot (largest log det of Lambda, the
+/// sum of information_about_robot, D-optimal), provided Lambda holds at least
 /// relocalization_min_information of the robot's information Omega_xx in every direction (the
-/// robot state is determined by them alone, well enough to stay where linearization holds). As many as the active set holds, the most informative first: a
-/// relocalized pose from the fewest that determine it (two range-bearing landmarks) tracked at 6x
-/// the EKF's error on kf-slam_demo, from eight in the order observed at 1.7x, from the eight most
-/// informative at 1.3x (docs/results/seif_relocalization.md).
+/// robot state is determined by them alone, well enough to stay where linearization holds). As
+/// many as the active set holds, the most informative first: a relocalized pose from the fewest
+/// that determine it (two range-bearing landmarks) tracked at 6x the EKF's error on kf-slam_demo,
+/// from eight in the order observed at 1.7x, from the eight most informative at 1.3x, and 1.16x
+/// once a landmark's own uncertainty counts (docs/results/seif_relocalization.md).
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::hold_back_for_relocalization(std::vector<MeasurementInformation>& observations,
                                                            std::size_t new_landmarks) const
@@ -527,19 +528,21 @@ auto SeifSlam<Motion, Sensor>::hold_back_for_relocalization(std::vector<Measurem
   for (const auto& [slot, block] : info_.robot_links()) active.insert(slot);
   for (const auto& info : observations) active.insert(info.slot);
   if (active.size() + new_landmarks <= options_.max_active || observations.empty()) return {};
+  std::vector<MatrixX> about_robot = information_about_robot(observations);
   MatrixX total = MatrixX::Zero();
-  for (const auto& info : observations) total += info.xx;
+  for (const auto& lambda : about_robot) total += lambda;
   const auto count = std::min(observations.size(), options_.max_active);
   MatrixX chosen = 1e-12 * total.trace() / X * MatrixX::Identity();  // log det defined from the first pick
   for (std::size_t k = 0; k < count; ++k) {
     std::size_t best = k;
     double best_log_det = -std::numeric_limits<double>::infinity();
     for (std::size_t j = k; j < observations.size(); ++j) {
-      const double log_det = (chosen + observations[j].xx).ldlt().vectorD().array().log().sum();
+      const double log_det = (chosen + about_robot[j]).ldlt().vectorD().array().log().sum();
       if (log_det > best_log_det) best_log_det = log_det, best = j;
     }
     std::swap(observations[k], observations[best]);
-    chosen += observations[k].xx;
+    std::swap(about_robot[k], about_robot[best]);
+    chosen += about_robot[k];
   }
   // Lambda_beta v = lambda Omega_ss v on the entries measurements see (s): the share of the robot's
   // information given the map that the held-back measurements carry, where they carry least.
@@ -556,6 +559,33 @@ auto SeifSlam<Motion, Sensor>::hold_back_for_relocalization(std::vector<Measurem
   std::vector<MeasurementInformation> held(std::make_move_iterator(observations.begin()), std::make_move_iterator(held_end));
   observations.erase(observations.begin(), held_end);
   return held;
+}
+
+/// What each observation tells about the robot once its landmark's uncertainty is counted: the
+/// measurement's information on (x, m) with the landmark's information W (given the other landmarks,
+/// marginal over the robot) added, the landmark then marginalized, xx - xm (mm + W)^-1 mx
+/// = H_x^T (Q + H_m W^-1 H_m^T)^-1 H_x. A landmark seen once tells next to nothing about where
+/// the robot is, however precise the measurement.
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::information_about_robot(const std::vector<MeasurementInformation>& observations) const
+    -> std::vector<Eigen::Matrix<double, X, X>> {
+  std::vector<Eigen::Matrix<double, X, X>> out;
+  out.reserve(observations.size());
+  const Eigen::LLT<Eigen::Matrix<double, X, X>> robot(info_.robot());
+  for (const auto& info : observations) {
+    Eigen::Matrix<double, M, M> W = info_.diagonal(info.slot);
+    if (robot.info() == Eigen::Success && info_.is_linked_to_robot(info.slot)) {
+      const Eigen::Matrix<double, X, M> link = info_.robot_link(info.slot);
+      W -= link.transpose() * robot.solve(link);
+    }
+    const Eigen::LLT<Eigen::Matrix<double, M, M>> landmark(symmetrized((W + info.mm).eval()));
+    if (landmark.info() != Eigen::Success) {
+      out.push_back(info.xx);
+      continue;
+    }
+    out.push_back(symmetrized((info.xx - info.xm * landmark.solve(info.xm.transpose())).eval()));
+  }
+  return out;
 }
 
 /// The information about the robot's seen entries given the map, Omega_ss; with an unseen tail t,
