@@ -4,6 +4,7 @@
 // and hands it to the caller. Every data-set family goes through it (experiments.hpp, run_globe.cpp,
 // run_vislam.cpp); a family that runs a back-end twice (SEIF per active-set size, the EKF with and
 // without first-estimate Jacobians) lists two choices.
+#include <algorithm>
 #include <optional>
 #include <sextant/core/error.hpp>
 #include <sextant/models/se2_world_frame.hpp>
@@ -54,19 +55,24 @@ inline SeifEstimate use_estimate(const std::optional<SeifEstimate>& choice, Seif
   return sparsification == SeifSparsification::relocalization ? SeifEstimate::exact_mean : SeifEstimate::recovered_mean;
 }
 
-/// One choice per kind, as the config sets it: the first-estimate policy for Motion's chart and
-/// FastSLAM's version from the kind.
+/// One choice per kind, as the config sets it: the first-estimate policy for Motion's chart,
+/// FastSLAM's version and eseif's relocalization from the kind. When [seif] sparsification is
+/// relocalization, seif is ESEIF already and eseif is left out (a row once).
 template <class Motion>
 std::vector<BackendChoice> backend_choices(const std::vector<BackendKind>& kinds, const RunnerConfig& c) {
   std::vector<BackendChoice> choices;
+  const bool seif_relocalizes = c.seif.sparsification == SeifSparsification::relocalization;
   for (BackendKind kind : kinds) {
+    if (kind == BackendKind::eseif && seif_relocalizes && std::find(kinds.begin(), kinds.end(), BackendKind::seif) != kinds.end())
+      continue;
     BackendChoice choice{kind, backend_key(kind), backend_label(kind, c), c.ekf, c.seif, c.graph, c.fastslam};
+    if (kind == BackendKind::eseif) choice.seif.sparsification = SeifSparsification::relocalization;
     choice.ekf.first_estimate_jacobians = use_first_estimates<Motion>(c.ekf_first_estimates);
     choice.seif.first_estimate_jacobians = use_first_estimates<Motion>(c.seif_first_estimates);
     choice.ekf.observability_constraints = use_observability_constraints<Motion>(c.ekf_observability_constraints);
     choice.seif.observability_constraints = use_observability_constraints<Motion>(c.seif_observability_constraints);
     choice.seif.estimate = use_estimate(c.seif_estimate, choice.seif.sparsification);
-    if (kind == BackendKind::seif && choice.seif.sparsification == SeifSparsification::relocalization)
+    if (kind == BackendKind::seif && seif_relocalizes)
       choice.label = "E" + choice.label;  // ESEIF-SLAM, Walter, Eustice and Leonard's exactly sparse filter
     choice.fastslam.version = kind == BackendKind::fastslam1 ? FastSlamVersion::v1 : FastSlamVersion::v2;
     choices.push_back(std::move(choice));
@@ -105,7 +111,8 @@ void with_backend(const BackendChoice& choice, const Motion& motion, const Senso
       EkfSlam<Motion, Sensor> backend(motion, sensor, prior, choice.ekf);
       return use(backend);
     }
-    case BackendKind::seif: {
+    case BackendKind::seif:
+    case BackendKind::eseif: {
       SeifSlam<Motion, Sensor> backend(motion, sensor, prior, choice.seif);
       return use(backend);
     }

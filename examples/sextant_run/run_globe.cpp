@@ -144,28 +144,22 @@ GlobeRun run_graph(Graph& graph, const Dataset& data, const RunnerConfig& c, std
   return out;
 }
 
-/// The globe's back-end configurations: SEIF once per [globe] seif_active; GraphSLAM as the thesis
+/// The globe's back-end configurations: SEIF once per [globe] seif_active, ESEIF once per [globe]
+/// eseif_active; GraphSLAM as the thesis
 /// ran it, windowed initialization (windows of 50 steps, 5 iterations each), then one global update
 /// per optimize(), and/or online ([globe] graph).
 std::vector<BackendChoice> globe_choices(const std::vector<BackendKind>& kinds, const RunnerConfig& c) {
   std::vector<BackendChoice> choices;
   for (auto choice : backend_choices<Motion>(kinds, c)) {
-    if (choice.kind == BackendKind::seif) {
-      const auto add = [&](BackendChoice seif, std::size_t active) {
-        const bool relocalizing = seif.seif.sparsification == SeifSparsification::relocalization;
+    if (choice.kind == BackendKind::seif || choice.kind == BackendKind::eseif) {
+      const bool relocalizing = choice.seif.sparsification == SeifSparsification::relocalization;
+      for (std::size_t active : choice.kind == BackendKind::seif ? c.globe.seif_active : c.globe.eseif_active) {
+        BackendChoice seif = choice;
         const std::string name = active ? std::to_string(active) : "all";
         seif.seif.max_active = active;
-        seif.seif.estimate = use_estimate(c.seif_estimate, seif.seif.sparsification);
         seif.key = (relocalizing ? "eseif" : "seif") + name;
         seif.label = (relocalizing ? "ESEIF-SLAM, " : "SEIF-SLAM, ") + name + " active";
         choices.push_back(std::move(seif));
-      };
-      for (std::size_t active : c.globe.seif_active) add(choice, active);
-      const bool seif_rows_relocalize = choice.seif.sparsification == SeifSparsification::relocalization;
-      choice.seif.sparsification = SeifSparsification::relocalization;
-      for (std::size_t active : c.globe.eseif_active) {
-        const bool listed = std::find(c.globe.seif_active.begin(), c.globe.seif_active.end(), active) != c.globe.seif_active.end();
-        if (!(seif_rows_relocalize && listed)) add(choice, active);  // a row once, not twice
       }
       continue;
     }

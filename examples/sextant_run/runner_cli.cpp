@@ -16,7 +16,7 @@ namespace {
 
 /// Declares the options every program takes.
 void add_runner_options(CLI::App& app, CliOptions& options, const char* program) {
-  app.add_option("--backend,-b", options.backends, "ekf|seif|graph|fastslam1|fastslam2|all (repeatable)")
+  app.add_option("--backend,-b", options.backends, "ekf|seif|eseif|graph|fastslam1|fastslam2|all (repeatable)")
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--dataset,-d", options.datasets, dataset_help(program));
@@ -54,7 +54,7 @@ std::vector<BackendKind> parse_backends(const std::vector<std::string>& names) {
     const auto it = std::find_if(all_backends().begin(), all_backends().end(),
                                  [&](BackendKind k) { return backend_key(k) == name; });
     if (it == all_backends().end())
-      throw invalid_input_error("--backend: unknown back-end '" + name + "' (ekf|seif|graph|fastslam1|fastslam2|all)");
+      throw invalid_input_error("--backend: unknown back-end '" + name + "' (ekf|seif|eseif|graph|fastslam1|fastslam2|all)");
     if (std::find(kinds.begin(), kinds.end(), *it) == kinds.end()) kinds.push_back(*it);
   }
   return kinds;

@@ -251,8 +251,8 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"globe", "seif_active", "150 250 0", "SEIF runs, one per value: active landmarks (0 = all)",
        [](RunnerConfig& c, const std::string& v) { c.globe.seif_active = parse_active_counts(v, false); }},
       {"globe", "eseif_active", "150 250",
-       "SEIF runs with relocalization (ESEIF, consistent; docs/results/seif_relocalization.md), one per value: "
-       "active landmarks (at least 1); 'none' = no such run",
+       "ESEIF runs (back-end eseif: SEIF with relocalization, consistent; docs/results/seif_relocalization.md), one "
+       "per value: active landmarks (at least 1); 'none' = no such run",
        [](RunnerConfig& c, const std::string& v) { c.globe.eseif_active = parse_active_counts(v, true); }},
       {"globe", "covariance_period", "10", "NEES of the pose every this many steps (a SEIF's covariance costs a factorization)",
        [](RunnerConfig& c, const std::string& v) { c.globe.covariance_period = parse_integer<std::size_t>(v, 1); }},

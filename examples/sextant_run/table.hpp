@@ -23,7 +23,10 @@ inline std::string backend_label(BackendKind kind, const RunnerConfig& c) {
   switch (kind) {
     case BackendKind::ekf: return "EKF-SLAM";
     case BackendKind::seif:
-      return c.seif.max_active ? "SEIF-SLAM, " + std::to_string(c.seif.max_active) + " active" : "SEIF-SLAM, all active";
+    case BackendKind::eseif: {
+      const std::string name = kind == BackendKind::eseif ? "ESEIF-SLAM, " : "SEIF-SLAM, ";
+      return name + (c.seif.max_active ? std::to_string(c.seif.max_active) : std::string("all")) + " active";
+    }
     case BackendKind::graph: return "GraphSLAM";
     case BackendKind::fastslam1: return "FastSLAM 1.0, " + std::to_string(c.fastslam.particles) + " particles";
     case BackendKind::fastslam2: return "FastSLAM 2.0, " + std::to_string(c.fastslam.particles) + " particles";

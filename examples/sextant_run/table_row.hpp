@@ -9,11 +9,13 @@
 
 namespace sextant::runner {
 
-enum class BackendKind { ekf, seif, graph, fastslam1, fastslam2 };
+/// eseif: SEIF with relocalization (Walter, Eustice and Leonard's exactly sparse filter) whatever
+/// [seif] sparsification says; seif follows it (the thesis's by default).
+enum class BackendKind { ekf, seif, eseif, graph, fastslam1, fastslam2 };
 
 inline const std::vector<BackendKind>& all_backends() {
-  static const std::vector<BackendKind> all = {BackendKind::ekf, BackendKind::seif, BackendKind::graph,
-                                               BackendKind::fastslam1, BackendKind::fastslam2};
+  static const std::vector<BackendKind> all = {BackendKind::ekf,   BackendKind::seif,      BackendKind::eseif,
+                                               BackendKind::graph, BackendKind::fastslam1, BackendKind::fastslam2};
   return all;
 }
 
@@ -22,6 +24,7 @@ inline std::string backend_key(BackendKind kind) {
   switch (kind) {
     case BackendKind::ekf: return "ekf";
     case BackendKind::seif: return "seif";
+    case BackendKind::eseif: return "eseif";
     case BackendKind::graph: return "graph";
     case BackendKind::fastslam1: return "fastslam1";
     case BackendKind::fastslam2: return "fastslam2";

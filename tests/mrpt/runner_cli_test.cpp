@@ -308,14 +308,35 @@ TEST_F(RunnerCli, ReadmeTableIsTheProgramsOutput) {
   all << readme.rdbuf();
   std::istringstream readme_lines(all.str());
   EXPECT_EQ(first_line_starting_with(readme_lines, "back-end"), program_header);
-  for (const char* label : {"EKF-SLAM", "SEIF-SLAM, 8 active", "GraphSLAM", "FastSLAM 1.0, 100 particles",
-                                   "FastSLAM 2.0, 100 particles"}) {
+  for (const char* label : {"EKF-SLAM", "SEIF-SLAM, 8 active", "ESEIF-SLAM, 8 active", "GraphSLAM",
+                            "FastSLAM 1.0, 100 particles", "FastSLAM 2.0, 100 particles"}) {
     EXPECT_NE(r.out.find(label), std::string::npos) << label << " not printed";
     EXPECT_NE(all.str().find(label), std::string::npos) << label << " not in the README";
   }
   for (const char* dataset : {"== ship", "== kf-slam_demo.rawlog", "== kf-slam_6D_demo.rawlog",
                                      "== kf-slam_6D_demo_noncentered.rawlog"})
     EXPECT_NE(all.str().find(dataset), std::string::npos) << dataset << " not in the README";
+}
+
+/// eseif is SEIF with relocalization beside seif, the thesis's; when [seif] sparsification makes seif
+/// relocalize as well, the two would be one filter, and the table shows it once.
+TEST_F(RunnerCli, EseifRunsBesideTheThesisSeifAndOnceWhenSeifRelocalizesToo) {
+  const auto ini = (dir / "eseif.ini").string();
+  std::ofstream(ini) << "[ship]\nruns = 1\nsteps = 60\n";
+  const auto rows_labelled = [](const std::string& out, const std::string& label) {
+    std::size_t count = 0;
+    for (auto at = out.find("\n" + label + " "); at != std::string::npos; at = out.find("\n" + label + " ", at + 1)) ++count;
+    return count;
+  };
+  const auto both = run_runner("-d ship -b seif,eseif -c " + ini, dir);
+  ASSERT_EQ(both.exit_code, 0) << both.err;
+  EXPECT_EQ(rows_labelled(both.out, "SEIF-SLAM, 8 active"), 1u) << both.out;
+  EXPECT_EQ(rows_labelled(both.out, "ESEIF-SLAM, 8 active"), 1u) << both.out;
+  std::ofstream(ini, std::ios::app) << "[seif]\nsparsification = relocalization\n";
+  const auto once = run_runner("-d ship -b seif,eseif -c " + ini, dir);
+  ASSERT_EQ(once.exit_code, 0) << once.err;
+  EXPECT_EQ(rows_labelled(once.out, "SEIF-SLAM, 8 active"), 0u) << once.out;
+  EXPECT_EQ(rows_labelled(once.out, "ESEIF-SLAM, 8 active"), 1u) << once.out;
 }
 
 TEST_F(RunnerCli, IniValuesReachTheBackEnds) {

@@ -73,11 +73,11 @@ io::LandmarkDataset<InWorldFrame<Unicycle>, SeenInWorldFrame<RangeBearing2D>> in
   return out;
 }
 
-/// The chosen back-ends split into those run in the world chart (EKF and SEIF, if `world`) and the rest.
+/// The chosen back-ends split into those run in the world chart (EKF, SEIF and ESEIF, if `world`) and the rest.
 std::pair<std::vector<BackendKind>, std::vector<BackendKind>> split_filters(const std::vector<BackendKind>& kinds, bool world) {
   std::pair<std::vector<BackendKind>, std::vector<BackendKind>> out;
   for (const BackendKind kind : kinds)
-    (world && (kind == BackendKind::ekf || kind == BackendKind::seif) ? out.first : out.second).push_back(kind);
+    (world && (kind == BackendKind::ekf || kind == BackendKind::seif || kind == BackendKind::eseif) ? out.first : out.second).push_back(kind);
   return out;
 }
 
