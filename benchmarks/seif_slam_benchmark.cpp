@@ -1,4 +1,5 @@
-// SEIF-SLAM time per step against map size with max_active fixed, beside EKF-SLAM, in one run; and the
+// SEIF-SLAM time per step against map size with max_active fixed (the thesis's sparsification and
+// relocalization, ESEIF), beside EKF-SLAM, in one run; and the
 // heap memory each holds per landmark (measured with glibc's mallinfo2 around the construction).
 // The ship drives around a circle of beacons, seeing the 4 nearest at every step. The *WithPose rows
 // add the pose() (mean and marginal covariance) an evaluation reads after every step: O(1) for the
@@ -6,6 +7,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <sextant/sextant.hpp>
 
@@ -25,8 +27,9 @@ const BeaconOffset2D kSensor{0.1};
 Gaussian<Eigen::Vector2d, 2> prior(const CircleWorld& world) { return {world.ship(0), 0.01 * Eigen::Matrix2d::Identity()}; }
 
 /// SEIF after one lap: every beacon mapped, the way a filter builds its map.
+template <SeifSparsification kSparsification = SeifSparsification::thesis>
 Seif seif_after_one_lap(const CircleWorld& world) {
-  Seif seif{kMotion, kSensor, prior(world), {.max_active = kMaxActive}};
+  Seif seif{kMotion, kSensor, prior(world), {.max_active = kMaxActive, .sparsification = kSparsification}};
   seif.update(world.observations(0));
   for (int step = 1; step <= world.count; ++step) {
     seif.predict(world.control(step), 1.0);
@@ -49,19 +52,27 @@ void run_steps(benchmark::State& state, Build build) {
   Backend backend = build(world);
   const double bytes = static_cast<double>(heap_in_use() - heap_before);
   int step = world.count;
+  std::uint64_t relocalizations_before = 0;
+  if constexpr (requires { backend.relocalizations(); }) relocalizations_before = backend.relocalizations();
   for (auto _ : state) {
     ++step;
     backend.predict(world.control(step), 1.0);
     benchmark::DoNotOptimize(backend.update(world.observations(step)));
     if constexpr (kReadPose) benchmark::DoNotOptimize(backend.pose());
   }
+  if constexpr (requires { backend.relocalizations(); })  // ESEIF: the share of steps that relocalized
+    state.counters["relocalized"] = static_cast<double>(backend.relocalizations() - relocalizations_before) /
+                                    static_cast<double>(step - world.count);
   state.counters["landmarks"] = world.count;
   state.counters["bytes_per_landmark"] = bytes / world.count;
 }
 
-void BM_SeifStep(benchmark::State& state) { run_steps<Seif, false>(state, seif_after_one_lap); }
+void BM_SeifStep(benchmark::State& state) { run_steps<Seif, false>(state, seif_after_one_lap<>); }
+void BM_EseifStep(benchmark::State& state) {
+  run_steps<Seif, false>(state, seif_after_one_lap<SeifSparsification::relocalization>);
+}
 void BM_EkfStep(benchmark::State& state) { run_steps<Ekf, false>(state, ekf_with_map); }
-void BM_SeifStepWithPose(benchmark::State& state) { run_steps<Seif, true>(state, seif_after_one_lap); }
+void BM_SeifStepWithPose(benchmark::State& state) { run_steps<Seif, true>(state, seif_after_one_lap<>); }
 void BM_EkfStepWithPose(benchmark::State& state) { run_steps<Ekf, true>(state, ekf_with_map); }
 
 void map_sizes(benchmark::internal::Benchmark* b) {
@@ -72,6 +83,7 @@ void map_sizes(benchmark::internal::Benchmark* b) {
 }  // namespace
 
 BENCHMARK(BM_SeifStep)->Apply(map_sizes);
+BENCHMARK(BM_EseifStep)->Apply(map_sizes);
 BENCHMARK(BM_EkfStep)->Apply(map_sizes);
 BENCHMARK(BM_SeifStepWithPose)->Apply(map_sizes);
 BENCHMARK(BM_EkfStepWithPose)->Apply(map_sizes);
