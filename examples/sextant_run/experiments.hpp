@@ -30,6 +30,7 @@ struct BackendRun {
   std::vector<State> particles;  ///< FastSLAM's particle poses after the last step
   std::optional<eval::AssociationScore> association;  ///< when the ids were withheld
   std::optional<CloudRow> cloud;                      ///< FastSLAM's cloud after the last step
+  std::optional<RelocalizationRow> relocalization;    ///< ESEIF's relocalizations over the run
 };
 
 /// Whether a back-end can run with its ids withheld: EKF and SEIF hand data association their joint
@@ -50,7 +51,7 @@ inline bool left_out(BackendKind kind, const RunnerConfig& c, const std::string&
 
 /// The row of a back-end that failed as a whole: its message instead of scores.
 inline TableRow failed_row(const std::string& dataset, const BackendChoice& choice, std::string why) {
-  TableRow row{dataset, choice.key, choice.label, {}, 1, std::nullopt, std::nullopt, std::nullopt};
+  TableRow row{dataset, choice.key, choice.label, {}, 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt};
   row.summary.mark_unscored();
   row.failure = std::move(why);
   return row;
@@ -70,6 +71,11 @@ BackendRun<Dataset> run_backend(const BackendChoice& choice, const Dataset& data
     if constexpr (requires { backend.distinct_ancestors(); })
       out.cloud = CloudRow{static_cast<double>(backend.particles().size()), backend.effective_sample_size(),
                            static_cast<double>(backend.distinct_ancestors())};
+    if constexpr (requires { backend.relocalizations(); })
+      if (backend.options().sparsification == SeifSparsification::relocalization)
+        out.relocalization = RelocalizationRow{static_cast<double>(data.steps.size()), static_cast<double>(backend.relocalizations()),
+                                               static_cast<double>(backend.active_landmarks().size()),
+                                               static_cast<double>(backend.options().max_active)};
   };
   /// Scored against the ground truth, or only recorded when the data set has none; a step that
   /// fails is counted in the run and skipped, never the end of the run (eval::StepErrors::skip).
@@ -125,9 +131,10 @@ std::vector<TableRow> run_on_rawlog(const std::string& name, const Dataset& data
       continue;
     }
     rows.push_back({name, choice.key, choice.label,
-                    eval::summarize(std::vector{result.run}, scoring.pose_dof, scoring.landmark_dof), 1, std::nullopt, std::nullopt, std::nullopt});
+                    eval::summarize(std::vector{result.run}, scoring.pose_dof, scoring.landmark_dof), 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt});
     if (const auto& a = result.association) rows.back().association = association_row(*a);
     rows.back().cloud = result.cloud;
+    rows.back().relocalization = result.relocalization;
     if constexpr (requires { data.has_ground_truth(); })
       if (!data.has_ground_truth()) rows.back().summary.mark_unscored();
     first_runs.emplace_back(kind, std::move(result));
@@ -165,6 +172,10 @@ std::vector<eval::StudyRecord> ship_records(const std::vector<BackendKind>& kind
       if (const auto& a = result.association) record.extras = association_extras(association_row(*a));
       if (const auto& cloud = result.cloud) {
         const auto extras = cloud_extras(*cloud);
+        record.extras.insert(record.extras.end(), extras.begin(), extras.end());
+      }
+      if (const auto& relocalization = result.relocalization) {
+        const auto extras = relocalization_extras(*relocalization);
         record.extras.insert(record.extras.end(), extras.begin(), extras.end());
       }
       if (seed == c.ship.seed) {

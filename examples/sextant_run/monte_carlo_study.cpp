@@ -23,6 +23,13 @@ std::vector<std::pair<std::string, double>> cloud_extras(const CloudRow& cloud) 
           {"cloud_distinct_ancestors", cloud.distinct_ancestors}};
 }
 
+std::vector<std::pair<std::string, double>> relocalization_extras(const RelocalizationRow& r) {
+  return {{"relocalization_steps", r.steps},
+          {"relocalizations", r.relocalizations},
+          {"relocalization_active", r.active},
+          {"relocalization_max_active", r.max_active}};
+}
+
 namespace {
 
 bool has_extra(const eval::StudyRecord& r, const char* name) {
@@ -34,6 +41,12 @@ std::optional<CloudRow> cloud_of(const eval::StudyRecord& r) {
   return CloudRow{r.extra("cloud_particles"), r.extra("cloud_effective_sample_size"), r.extra("cloud_distinct_ancestors")};
 }
 
+std::optional<RelocalizationRow> relocalization_of(const eval::StudyRecord& r) {
+  if (!has_extra(r, "relocalizations")) return std::nullopt;
+  return RelocalizationRow{r.extra("relocalization_steps"), r.extra("relocalizations"), r.extra("relocalization_active"),
+                           r.extra("relocalization_max_active")};
+}
+
 std::optional<AssociationRow> association_of(const eval::StudyRecord& r) {
   if (!has_extra(r, "association_precision")) return std::nullopt;
   return AssociationRow{r.extra("association_precision"), r.extra("association_recall"), static_cast<std::size_t>(r.extra("association_wrong")),
@@ -43,7 +56,7 @@ std::optional<AssociationRow> association_of(const eval::StudyRecord& r) {
 
 /// The row of one cell's runs (records[begin, end), in seed order).
 TableRow row_of(std::vector<eval::StudyRecord>::const_iterator begin, std::vector<eval::StudyRecord>::const_iterator end) {
-  TableRow row{begin->dataset, begin->cell, begin->label, {}, static_cast<int>(end - begin), std::nullopt, std::nullopt, std::nullopt};
+  TableRow row{begin->dataset, begin->cell, begin->label, {}, static_cast<int>(end - begin), std::nullopt, std::nullopt, std::nullopt, std::nullopt};
   std::vector<eval::RunScores> scores;
   for (auto r = begin; r != end; ++r) {
     if (!r->failure.empty() && !row.failure) row.failure = "seed " + std::to_string(r->seed) + ": " + r->failure;
@@ -56,6 +69,7 @@ TableRow row_of(std::vector<eval::StudyRecord>::const_iterator begin, std::vecto
   row.summary = eval::summarize(scores, begin->pose_dof);
   row.association = association_of(*begin);  // the first seed's
   row.cloud = cloud_of(*begin);
+  row.relocalization = relocalization_of(*begin);
   return row;
 }
 

@@ -18,6 +18,8 @@ std::vector<TableRow> rows_of(const std::vector<eval::StudyRecord>& records);
 std::vector<std::pair<std::string, double>> association_extras(const AssociationRow& a);
 /// A FastSLAM run's cloud at its end as a record's extras (read back by the table's row).
 std::vector<std::pair<std::string, double>> cloud_extras(const CloudRow& cloud);
+/// An ESEIF run's relocalizations as a record's extras (read back by the table's row).
+std::vector<std::pair<std::string, double>> relocalization_extras(const RelocalizationRow& relocalization);
 
 /// --merge: prints the table of the study whose record files (or directories of them) are `paths`
 /// and returns its rows.

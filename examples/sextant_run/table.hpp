@@ -77,6 +77,10 @@ inline void print_row(const TableRow& row) {
   if (const auto& cloud = row.cloud)
     std::printf("%-29s the cloud at the end: N_eff %.3g of %.0f; all descend from %.0f of the %.0f it started with\n", "",
                 cloud->effective_sample_size, cloud->particles, cloud->distinct_ancestors, cloud->particles);
+  if (const auto& r = row.relocalization)
+    std::printf("%-29s relocalized at %.0f of %.0f steps; %.0f landmarks linked to the robot at the end (at most %.0f%s)\n", "",
+                r->relocalizations, r->steps, r->active, r->max_active,
+                r->active > r->max_active ? " when a held-back set carries enough information" : "");
   print_skipped_steps(29, row.summary.failed_steps, "step", row.summary.first_failure);  // over all its runs
 }
 
@@ -124,6 +128,8 @@ inline void write_summary_json(const std::string& path, const std::vector<TableR
     if (const auto& a = rows[i].association)
       out << ", \"association_precision\": " << json_number(a->precision)
           << ", \"association_recall\": " << json_number(a->recall);
+    if (const auto& r = rows[i].relocalization)
+      out << ", \"relocalizations\": " << json_number(r->relocalizations) << ", \"active_at_end\": " << json_number(r->active);
     out << "}" << (i + 1 < rows.size() ? ",\n" : "\n");
   }
   out << "]\n";

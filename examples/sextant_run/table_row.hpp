@@ -59,6 +59,13 @@ struct CloudRow {
   double particles, effective_sample_size, distinct_ancestors;
 };
 
+/// An ESEIF run at its end (SeifSparsification::relocalization): how often it relocalized and how
+/// many landmarks stay linked to the robot. A run that never relocalizes is an exact SEIF at the
+/// cost of one whose active set grows (docs/results/seif_relocalization.md).
+struct RelocalizationRow {
+  double steps, relocalizations, active, max_active;
+};
+
 /// A line of the comparison table.
 struct TableRow {
   std::string dataset, backend, label;
@@ -67,6 +74,7 @@ struct TableRow {
   std::optional<AssociationRow> association;
   std::optional<std::string> failure;  ///< why the back-end gave no result: its row prints this instead
   std::optional<CloudRow> cloud;       ///< FastSLAM: the first run's cloud at its end
+  std::optional<RelocalizationRow> relocalization;  ///< ESEIF: the first run's relocalizations
 };
 
 }  // namespace sextant::runner

@@ -318,8 +318,9 @@ TEST_F(RunnerCli, ReadmeTableIsTheProgramsOutput) {
     EXPECT_NE(all.str().find(dataset), std::string::npos) << dataset << " not in the README";
 }
 
-/// eseif is SEIF with relocalization beside seif, the thesis's; when [seif] sparsification makes seif
-/// relocalize as well, the two would be one filter, and the table shows it once.
+/// eseif is SEIF with relocalization beside seif, the thesis's, with a line saying how often it
+/// relocalized; when [seif] sparsification makes seif relocalize as well, the two would be one
+/// filter, and the table shows it once.
 TEST_F(RunnerCli, EseifRunsBesideTheThesisSeifAndOnceWhenSeifRelocalizesToo) {
   const auto ini = (dir / "eseif.ini").string();
   std::ofstream(ini) << "[ship]\nruns = 1\nsteps = 60\n";
@@ -332,6 +333,7 @@ TEST_F(RunnerCli, EseifRunsBesideTheThesisSeifAndOnceWhenSeifRelocalizesToo) {
   ASSERT_EQ(both.exit_code, 0) << both.err;
   EXPECT_EQ(rows_labelled(both.out, "SEIF-SLAM, 8 active"), 1u) << both.out;
   EXPECT_EQ(rows_labelled(both.out, "ESEIF-SLAM, 8 active"), 1u) << both.out;
+  EXPECT_NE(both.out.find("relocalized at "), std::string::npos) << both.out;  // ESEIF's line, below its row
   std::ofstream(ini, std::ios::app) << "[seif]\nsparsification = relocalization\n";
   const auto once = run_runner("-d ship -b seif,eseif -c " + ini, dir);
   ASSERT_EQ(once.exit_code, 0) << once.err;
