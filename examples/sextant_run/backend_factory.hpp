@@ -80,6 +80,17 @@ std::vector<BackendChoice> backend_choices(const std::vector<BackendKind>& kinds
   return choices;
 }
 
+/// An ESEIF run's relocalizations after `steps` steps (the line below its row); none for the others.
+template <class Backend>
+std::optional<RelocalizationRow> relocalization_row(const Backend& backend, std::size_t steps) {
+  if constexpr (requires { backend.relocalizations(); })
+    if (backend.options().sparsification == SeifSparsification::relocalization)
+      return RelocalizationRow{static_cast<double>(steps), static_cast<double>(backend.relocalizations()),
+                               static_cast<double>(backend.active_landmarks().size()),
+                               static_cast<double>(backend.options().max_active)};
+  return std::nullopt;
+}
+
 /// Calls run(); a sextant::error it throws (a back-end failing as a whole: its options, its final
 /// optimization) comes back as its message, so that the caller reports it in that back-end's row and
 /// goes on with the others.

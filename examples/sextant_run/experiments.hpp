@@ -71,11 +71,7 @@ BackendRun<Dataset> run_backend(const BackendChoice& choice, const Dataset& data
     if constexpr (requires { backend.distinct_ancestors(); })
       out.cloud = CloudRow{static_cast<double>(backend.particles().size()), backend.effective_sample_size(),
                            static_cast<double>(backend.distinct_ancestors())};
-    if constexpr (requires { backend.relocalizations(); })
-      if (backend.options().sparsification == SeifSparsification::relocalization)
-        out.relocalization = RelocalizationRow{static_cast<double>(data.steps.size()), static_cast<double>(backend.relocalizations()),
-                                               static_cast<double>(backend.active_landmarks().size()),
-                                               static_cast<double>(backend.options().max_active)};
+    out.relocalization = relocalization_row(backend, data.steps.size());
   };
   /// Scored against the ground truth, or only recorded when the data set has none; a step that
   /// fails is counted in the run and skipped, never the end of the run (eval::StepErrors::skip).

@@ -60,6 +60,7 @@ struct GlobeRun {
   std::vector<std::size_t> nees_steps;            ///< the step of each pose NEES in scores
   eval::StepFailures failures;                    ///< steps that failed and were skipped
   std::optional<std::string> failure;             ///< why the back-end as a whole gave no result
+  std::optional<RelocalizationRow> relocalization;  ///< ESEIF's relocalizations over the run
 };
 
 /// The landmarks of `map` that have a true point (a rendered front-end may propose a landmark whose
@@ -87,6 +88,7 @@ GlobeRun run_filter(Backend& backend, const Dataset& data, const RunnerConfig& c
   out.total_seconds = run.total_seconds;
   out.step_seconds = std::move(run.seconds);
   for (const auto& sampled : run.poses) out.nees_steps.push_back(sampled.step);
+  out.relocalization = relocalization_row(backend, data.steps.size());
   return out;
 }
 
@@ -253,6 +255,7 @@ void print_globe_row(const GlobeRun& r, std::size_t steps) {
               1e3 * s.map_mae_aligned, share(s.position_nees_inside).c_str(), share(s.rotation_nees_inside).c_str(),
               share(s.map_nees_inside).c_str(), number(s.position_anees).c_str(), r.total_seconds,
               1e3 * r.total_seconds / static_cast<double>(steps));
+  if (r.relocalization) print_relocalization(27, *r.relocalization);
   print_skipped_steps(27, r.failures.total(), "step", r.failures.first);
 }
 
@@ -269,7 +272,7 @@ TableRow table_row(const GlobeRun& r, std::size_t steps) {
   s.seconds_per_step = r.total_seconds / static_cast<double>(steps);
   s.failed_steps = r.failures.total();
   s.first_failure = r.failures.first;
-  TableRow row{"globe", r.key, r.label, s, 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt};
+  TableRow row{"globe", r.key, r.label, s, 1, std::nullopt, std::nullopt, std::nullopt, r.relocalization};
   if (r.failure) {
     row.summary.mark_unscored();
     row.failure = r.failure;

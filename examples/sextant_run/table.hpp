@@ -61,6 +61,13 @@ inline void print_skipped_steps(int indent, std::size_t count, const char* unit,
               count == 1 ? "" : "s", first.c_str());
 }
 
+/// The line below an ESEIF row: how often it relocalized, how many landmarks stay linked to the robot.
+inline void print_relocalization(int indent, const RelocalizationRow& r) {
+  std::printf("%-*s relocalized at %.0f of %.0f steps; %.0f landmarks linked to the robot at the end (at most %.0f%s)\n",
+              indent, "", r.relocalizations, r.steps, r.active, r.max_active,
+              r.active > r.max_active ? " when a held-back set carries enough information" : "");
+}
+
 inline void print_row(const TableRow& row) {
   if (row.failure) {
     std::printf("%-29s failed: %s\n", row.label.c_str(), row.failure->c_str());
@@ -77,10 +84,7 @@ inline void print_row(const TableRow& row) {
   if (const auto& cloud = row.cloud)
     std::printf("%-29s the cloud at the end: N_eff %.3g of %.0f; all descend from %.0f of the %.0f it started with\n", "",
                 cloud->effective_sample_size, cloud->particles, cloud->distinct_ancestors, cloud->particles);
-  if (const auto& r = row.relocalization)
-    std::printf("%-29s relocalized at %.0f of %.0f steps; %.0f landmarks linked to the robot at the end (at most %.0f%s)\n", "",
-                r->relocalizations, r->steps, r->active, r->max_active,
-                r->active > r->max_active ? " when a held-back set carries enough information" : "");
+  if (const auto& r = row.relocalization) print_relocalization(29, *r);
   print_skipped_steps(29, row.summary.failed_steps, "step", row.summary.first_failure);  // over all its runs
 }
 
