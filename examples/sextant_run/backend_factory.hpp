@@ -72,8 +72,6 @@ std::vector<BackendChoice> backend_choices(const std::vector<BackendKind>& kinds
     choice.ekf.observability_constraints = use_observability_constraints<Motion>(c.ekf_observability_constraints);
     choice.seif.observability_constraints = use_observability_constraints<Motion>(c.seif_observability_constraints);
     choice.seif.estimate = use_estimate(c.seif_estimate, choice.seif.sparsification);
-    if (kind == BackendKind::seif && seif_relocalizes)
-      choice.label = "E" + choice.label;  // ESEIF-SLAM, Walter, Eustice and Leonard's exactly sparse filter
     choice.fastslam.version = kind == BackendKind::fastslam1 ? FastSlamVersion::v1 : FastSlamVersion::v2;
     choices.push_back(std::move(choice));
   }

@@ -160,7 +160,7 @@ std::vector<BackendChoice> globe_choices(const std::vector<BackendKind>& kinds, 
         const std::string name = active ? std::to_string(active) : "all";
         seif.seif.max_active = active;
         seif.key = (relocalizing ? "eseif" : "seif") + name;
-        seif.label = (relocalizing ? "ESEIF-SLAM, " : "SEIF-SLAM, ") + name + " active";
+        seif.label = seif_label(relocalizing, active);
         choices.push_back(std::move(seif));
       }
       continue;

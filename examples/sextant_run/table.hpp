@@ -18,15 +18,21 @@
 
 namespace sextant::runner {
 
+/// SEIF's name in the table: ESEIF-SLAM when it relocalizes (Walter, Eustice and Leonard's exactly
+/// sparse filter), with its active-set size (0 = all).
+inline std::string seif_label(bool relocalizing, std::size_t max_active) {
+  return std::string(relocalizing ? "ESEIF-SLAM, " : "SEIF-SLAM, ") + (max_active ? std::to_string(max_active) : "all") +
+         " active";
+}
+
 /// The table's name of a back-end with its main setting.
 inline std::string backend_label(BackendKind kind, const RunnerConfig& c) {
   switch (kind) {
     case BackendKind::ekf: return "EKF-SLAM";
     case BackendKind::seif:
-    case BackendKind::eseif: {
-      const std::string name = kind == BackendKind::eseif ? "ESEIF-SLAM, " : "SEIF-SLAM, ";
-      return name + (c.seif.max_active ? std::to_string(c.seif.max_active) : std::string("all")) + " active";
-    }
+    case BackendKind::eseif:
+      return seif_label(kind == BackendKind::eseif || c.seif.sparsification == SeifSparsification::relocalization,
+                        c.seif.max_active);
     case BackendKind::graph: return "GraphSLAM";
     case BackendKind::fastslam1: return "FastSLAM 1.0, " + std::to_string(c.fastslam.particles) + " particles";
     case BackendKind::fastslam2: return "FastSLAM 2.0, " + std::to_string(c.fastslam.particles) + " particles";
