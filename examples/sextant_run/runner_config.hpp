@@ -57,6 +57,11 @@ struct GlobeSettings {
   bool graph_online = false;           ///< [globe] graph: the online (incremental) GraphSLAM row
   /// globe-stereo and stereo:DIR: the back-end that tracks the images online and gates the association
   BackendKind tracker = BackendKind::ekf;
+  /// [globe] tracker_gate: a SEIF tracker gates with the exact joint marginal (a factorization of
+  /// Omega a frame) instead of the robot and each landmark conditioned on the rest of the map
+  bool tracker_exact_gate = false;
+  int octave_layers = 4;            ///< globe-stereo, stereo:DIR: AKAZE's sublevels per octave (vision::DetectorOptions)
+  double detector_threshold = 0.001;  ///< globe-stereo, stereo:DIR: AKAZE's response threshold
 };
 
 /// The visual-inertial runs' settings (run_vislam.cpp): the models' noise for .npz data (the
@@ -257,12 +262,26 @@ inline const std::vector<ConfigKey>& config_keys() {
       {"globe", "covariance_period", "10", "NEES of the pose every this many steps (a SEIF's covariance costs a factorization)",
        [](RunnerConfig& c, const std::string& v) { c.globe.covariance_period = parse_integer<std::size_t>(v, 1); }},
       {"globe", "tracker", "ekf",
-       "globe-stereo, stereo:DIR: the back-end that tracks the images and gates the association: ekf or seif (its "
-       "first seif_active value; its exact gate solves with the factor of Omega every frame)",
+       "globe-stereo, stereo:DIR: the back-end that tracks the images and gates the association: ekf, seif (its "
+       "first seif_active value, [seif]'s sparsification) or eseif (relocalizing, its first eseif_active value)",
        [](RunnerConfig& c, const std::string& v) {
-         if (v != "ekf" && v != "seif") throw invalid_input_error("'" + v + "' is not a tracker (ekf or seif)");
-         c.globe.tracker = v == "ekf" ? BackendKind::ekf : BackendKind::seif;
+         if (v != "ekf" && v != "seif" && v != "eseif")
+           throw invalid_input_error("'" + v + "' is not a tracker (ekf, seif or eseif)");
+         c.globe.tracker = v == "ekf" ? BackendKind::ekf : v == "seif" ? BackendKind::seif : BackendKind::eseif;
        }},
+      {"globe", "tracker_gate", "conditional",
+       "a SEIF tracker's gate: conditional (the robot and each landmark given the rest of the map, O(1) per "
+       "landmark) | joint_marginal (exact: one solve with the factor of Omega a frame)",
+       [](RunnerConfig& c, const std::string& v) {
+         if (v != "conditional" && v != "joint_marginal")
+           throw invalid_input_error("'" + v + "' is not a tracker gate (conditional or joint_marginal)");
+         c.globe.tracker_exact_gate = v == "joint_marginal";
+       }},
+      {"globe", "octave_layers", "4",
+       "globe-stereo, stereo:DIR: AKAZE's sublevels per octave (OpenCV's default 4; its time is mostly building them)",
+       [](RunnerConfig& c, const std::string& v) { c.globe.octave_layers = parse_integer<int>(v, 1, 16); }},
+      {"globe", "detector_threshold", "0.001", "globe-stereo, stereo:DIR: AKAZE's response threshold (OpenCV's default)",
+       [](RunnerConfig& c, const std::string& v) { c.globe.detector_threshold = positive(parse_number(v), v); }},
       {"globe", "graph_updates", "10", "GraphSLAM global updates after the windowed initialization (thesis Table 10: 10)",
        [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = parse_integer<int>(v, 1, 1e4); }},
       {"globe", "graph", "batch",

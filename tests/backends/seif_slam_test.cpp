@@ -11,6 +11,7 @@
 #include "sextant/eval/metrics.hpp"
 #include "support/nees_bound.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 
 #include "sextant/backends/ekf_slam.hpp"
@@ -389,6 +390,38 @@ TEST(SeifSlam, RemoveLandmarkMarginalizesWithoutChangingTheOtherMarginals) {
     EXPECT_LT((after.cov - estimate.cov).cwiseAbs().maxCoeff(), 1e-9) << estimate.id;
   }
   EXPECT_THROW(seif.remove_landmark(removed), unknown_landmark_error);
+}
+
+/// The gate's cheap covariance: for each landmark, the robot and the landmark conditioned on the rest
+/// is the inverse of their block of Omega (the Schur complement of the rest in Sigma), and never wider
+/// than their joint marginal (conditioning cannot add uncertainty): Sigma_joint - C is PSD.
+TEST(SeifSlam, ConditionalJointsInvertTheirInformationBlockAndAreNeverWiderThanTheJointMarginal) {
+  const auto data = sim::simulate_ship_2d({.seed = 9, .num_steps = 120});
+  Seif seif{data.motion, data.sensor, data.prior, {.max_active = 4}};
+  eval::run(seif, data.steps);
+  const std::vector<LandmarkId> ids(seif.landmark_ids().begin(), seif.landmark_ids().end());
+  const auto conditional = seif.conditional_joints(std::span<const LandmarkId>(ids));
+  ASSERT_EQ(conditional.size(), ids.size());
+  const Eigen::MatrixXd omega = Eigen::MatrixXd(seif.information_matrix());
+  const Eigen::MatrixXd sigma = omega.inverse();
+  constexpr int X = Seif::State::RowsAtCompileTime;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const Eigen::Index a = X + 2 * static_cast<Eigen::Index>(i);  // slot order is landmark_ids() order
+    const std::vector<Eigen::Index> rows{0, 1, a, a + 1};
+    Eigen::Matrix4d block, joint;
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) {
+        block(r, c) = omega(rows[r], rows[c]);
+        joint(r, c) = sigma(rows[r], rows[c]);
+      }
+    EXPECT_LT(max_relative_difference(conditional[i], block.inverse()), 1e-9) << ids[i];
+    const Eigen::Matrix4d wider = joint - conditional[i];
+    EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(0.5 * (wider + wider.transpose())).eigenvalues().minCoeff(),
+              -1e-9 * joint.norm())
+        << ids[i];
+  }
+  const std::vector<LandmarkId> unknown{999999};
+  EXPECT_THROW(seif.conditional_joints(std::span<const LandmarkId>(unknown)), unknown_landmark_error);
 }
 
 TEST(SeifSlam, ReportsTheStageTimesOfTheLastUpdateThatSucceeded) {

@@ -60,6 +60,23 @@ TEST_F(GlobeStereoRunner, SavedImagesReadBackGiveTheSameObservations) {
   EXPECT_TRUE(fs::exists(dir / "b" / "stereo" / "ekf_trajectory.tum"));
 }
 
+/// `[globe] tracker = eseif` tracks with the relocalizing SEIF (its conditional gate by default); an
+/// eseif tracker without an active count is refused with a line naming the key.
+TEST_F(GlobeStereoRunner, AnEseifTrackerTracksAndOneWithoutAnActiveCountIsRefused) {
+  const auto ini = dir / "eseif.ini";
+  std::ofstream(ini) << "[globe]\nsteps = 8\ntracker = eseif\neseif_active = 150\n";
+  const auto r = run_program(std::string(SEXTANT_GLOBE_STEREO_EXE) + " -d globe-stereo -b eseif -c " + ini.string(), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* text : {"ESEIF back-end", "association precision", "ESEIF-SLAM, 150 active"})
+    EXPECT_NE(r.out.find(text), std::string::npos) << text << " missing from:\n" << r.out;
+
+  const auto none = dir / "none.ini";
+  std::ofstream(none) << "[globe]\nsteps = 8\ntracker = eseif\neseif_active = none\n";
+  const auto refused = run_program(std::string(SEXTANT_GLOBE_STEREO_EXE) + " -d globe-stereo -b ekf -c " + none.string(), dir);
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.err.find("eseif_active"), std::string::npos) << refused.err;
+}
+
 TEST_F(GlobeStereoRunner, ABadSequenceStopsWithOneLineNamingTheFile) {
   fs::create_directories(dir / "empty" / "left");
   fs::create_directories(dir / "empty" / "right");

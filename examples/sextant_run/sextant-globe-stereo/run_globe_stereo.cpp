@@ -133,20 +133,30 @@ vision::StereoTrackerOptions tracker_options(const RunnerConfig& c) {
   vision::StereoTrackerOptions o;
   o.pool = c.globe.pool;
   o.association.max_observations = static_cast<std::size_t>(c.globe.features_per_frame);
+  o.front_end.detector.octave_layers = c.globe.octave_layers;
+  o.front_end.detector.threshold = static_cast<float>(c.globe.detector_threshold);
+  o.gate_covariance = c.globe.tracker_exact_gate ? vision::GateCovariance::joint_marginal : vision::GateCovariance::conditional;
   return o;
 }
 
 /// Calls `run(tracker, name)` with the stereo tracker of [globe] tracker: the EKF with [ekf]'s
-/// options, or SEIF with [seif]'s and the first [globe] seif_active value.
+/// options, SEIF with [seif]'s and the first [globe] seif_active value, or ESEIF (relocalizing) with
+/// the first eseif_active value.
 template <class Run>
 auto with_tracker(const RunnerConfig& c, const EulerCamera12D& motion, const PointInCamera3D& sensor,
                   const Gaussian<Vector12d, 12>& prior, const vision::StereoRig& rig, int width, int height, Run&& run) {
-  if (c.globe.tracker == BackendKind::seif) {
+  if (c.globe.tracker == BackendKind::seif || c.globe.tracker == BackendKind::eseif) {
+    const bool relocalizing = c.globe.tracker == BackendKind::eseif;
+    const auto& active = relocalizing ? c.globe.eseif_active : c.globe.seif_active;
+    if (active.empty())
+      throw invalid_input_error(std::string("[globe] tracker = ") + (relocalizing ? "eseif" : "seif") + " needs a [globe] " +
+                                (relocalizing ? "eseif_active" : "seif_active") + " value");
     SeifOptions seif = c.seif;
-    seif.max_active = c.globe.seif_active.front();
+    seif.max_active = active.front();
+    if (relocalizing) seif.sparsification = SeifSparsification::relocalization;
     vision::StereoTracker<SeifSlam<EulerCamera12D, PointInCamera3D>> tracker(
         {motion, sensor, prior, seif}, sensor, rig, width, height, tracker_options(c));
-    return run(tracker, std::string("SEIF"));
+    return run(tracker, std::string(seif.sparsification == SeifSparsification::relocalization ? "ESEIF" : "SEIF"));
   }
   vision::StereoTracker<EkfSlam<EulerCamera12D, PointInCamera3D>> tracker({motion, sensor, prior, c.ekf}, sensor,
                                                                            rig, width, height, tracker_options(c));

@@ -164,6 +164,18 @@ class SeifSlam {
   /// the means are the recovered ones the update linearizes at.
   /// Throws unknown_landmark_error.
   JointMarginal<State, M> joint_marginal(std::span<const LandmarkId> ids) const;
+  /// Per landmark of `ids`, the robot and that landmark conditioned on the rest of the state,
+  /// (Omega_BB)^-1 for B = {robot, landmark}: O(1) each, no factorization of Omega (the gate of
+  /// Probabilistic Robotics §12.7, per landmark). Never wider than the joint marginal; for a
+  /// measurement relative to the robot it loses only what the rest of the map says about their
+  /// relative position (on the globe, S within 1.06x of the exact one: docs/results/real_time.md).
+  /// Throws unknown_landmark_error, or numerical_error when a block is not positive definite.
+  std::vector<Eigen::Matrix<double, X + M, X + M>> conditional_joints(std::span<const LandmarkId> ids) const;
+  /// Every landmark's id and the mean the update linearizes at (SeifEstimate::recovered_mean), O(n)
+  /// without a solve, whatever SeifOptions::estimate says: what a gate must predict from.
+  std::vector<std::pair<LandmarkId, Landmark>> linearization_means() const {
+    return landmarks_.id_mean_pairs([&](std::size_t slot) { return landmark_mean(slot); });
+  }
   bool has_landmark(LandmarkId id) const { return landmarks_.contains(id); }
   std::size_t num_landmarks() const { return landmarks_.size(); }
   const std::vector<LandmarkId>& landmark_ids() const { return landmarks_.ids(); }

@@ -297,26 +297,36 @@ void SparseInformation<X, M>::marginalize_landmark(std::size_t slot) {
   const Eigen::LLT<LandmarkBlock> llt(diagonal_[slot]);
   if (llt.info() != Eigen::Success)
     throw numerical_error("information block of the landmark to marginalize is not positive definite");
-  const LandmarkVector r_j = landmark_residual(slot);
+  // Schur complement on the neighbourhood {robot, linked landmarks}: with Omega_jj = L L^T, each
+  // term Omega_{a,j} Omega_jj^-1 Omega_{j,b} is G_a^T G_b for G_a = L^-1 Omega_{j,a}, one triangular
+  // solve per neighbour instead of one per pair.
+  const auto& L = llt.matrixL();
+  const LandmarkVector g_r = L.solve(landmark_residual(slot));
   const bool robot_linked = is_linked_to_robot(slot);
-  const CrossBlock L_x = robot_link(slot);  // Omega_{x, j}
-  // Omega_{j, a} of every linked landmark a.
-  std::vector<std::pair<std::size_t, LandmarkBlock>> neighbours(links_[slot].begin(), links_[slot].end());
-  // Schur complement on the neighbourhood {robot, linked landmarks}.
+  const Eigen::Matrix<double, M, X> g_x = L.solve(robot_link(slot).transpose());  // L^-1 Omega_{j, x}
+  std::vector<std::size_t> neighbours;
+  std::vector<LandmarkBlock> g;  // G_a of each neighbour, in `neighbours` order
+  neighbours.reserve(links_[slot].size());
+  g.reserve(links_[slot].size());
+  for (const auto& [a, O_ja] : links_[slot]) {
+    neighbours.push_back(a);
+    g.push_back(L.solve(O_ja));
+  }
   if (robot_linked) {
-    robot_ -= L_x * llt.solve(L_x.transpose());
-    robot_residual_ -= L_x * llt.solve(r_j);
+    robot_ -= g_x.transpose() * g_x;
+    robot_residual_ -= g_x.transpose() * g_r;
   }
-  for (const auto& [a, O_ja] : neighbours) {
-    landmark_residual(a) -= O_ja.transpose() * llt.solve(r_j);
-    diagonal_[a] -= O_ja.transpose() * llt.solve(O_ja);
-    if (robot_linked) add_to_robot_link(a, -L_x * llt.solve(O_ja));
-    for (const auto& [b, O_jb] : neighbours)
-      if (a < b) add_to_link(a, b, -O_ja.transpose() * llt.solve(O_jb));
+  for (std::size_t k = 0; k < neighbours.size(); ++k) {
+    const std::size_t a = neighbours[k];
+    landmark_residual(a) -= g[k].transpose() * g_r;
+    diagonal_[a] -= g[k].transpose() * g[k];
+    if (robot_linked) add_to_robot_link(a, -g_x.transpose() * g[k]);
   }
+  add_to_links(std::span<const std::size_t>(neighbours),
+               [&](std::size_t a, std::size_t b) -> LandmarkBlock { return -g[a].transpose() * g[b]; });
   // Unlink and drop the slot.
   remove_robot_link(slot);
-  for (const auto& [a, block] : neighbours) links_[a].erase(slot);
+  for (const std::size_t a : neighbours) links_[a].erase(slot);
   links_[slot].clear();
   const std::size_t last = num_landmarks() - 1;
   if (slot != last) move_slot(last, slot);

@@ -8,9 +8,11 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <span>
@@ -37,6 +39,17 @@ struct MapAssociationOptions {
   /// ratio x the second nearest (Lowe's test); 1 turns the test off.
   double ratio = 0.8;
   std::size_t max_observations = 120;  ///< per frame: associated features first, then new ones
+};
+
+/// Which covariance of the robot and a landmark the gate's innovation covariance S comes from.
+enum class GateCovariance {
+  /// Their joint marginal: a gather from P (EKF), one multi-column solve with the factor of Omega
+  /// for all landmarks in view (SEIF; on the globe's dense Omega ~1.8 s a frame at Mmax 1000).
+  joint_marginal,
+  /// Information-form back-ends: the robot and the landmark conditioned on the rest of the map,
+  /// O(1) per landmark (SeifSlam::conditional_joints), S within 1.06x of the exact one on the globe;
+  /// back-ends without it use the joint marginal.
+  conditional,
 };
 
 /// A map landmark's predicted measurement with the inverse of its innovation covariance.
@@ -74,21 +87,29 @@ struct FrameAssociation {
 };
 
 /// The predicted measurement and innovation covariance of every landmark whose mean lies in front
-/// of the camera and projects inside the image (the only ones a feature can be). The means come
-/// from the back-end's landmark_means() (O(n), no covariances); S from its joint marginal of the robot
-/// and each landmark: per landmark where that is a gather (EKF: O(1) blocks of P each), in one call
-/// for all of them where it is a solve (an information-form back-end such as SEIF: one multi-column
-/// solve with the factor of Omega instead of one per landmark). The cross terms between landmarks,
-/// which only a joint test would need, are not used. Landmarks the model cannot predict or whose S
-/// is not positive definite are left out; an Omega that cannot be factorized throws numerical_error.
+/// of the camera and projects inside the image (the only ones a feature can be). The means are the
+/// ones the back-end's update linearizes at (SEIF's linearization_means(), else landmark_means():
+/// O(n), no covariances); S comes from the covariance `gate` names: per landmark where that is a
+/// gather (EKF: O(1) blocks of P each, or SEIF's conditional blocks), in one call for all of them
+/// where it is a solve (SEIF's joint marginal: one multi-column solve with the factor of Omega
+/// instead of one per landmark). The cross terms between landmarks, which only a joint test would
+/// need, are not used. Landmarks the model cannot predict or whose S is not positive definite are
+/// left out; an Omega that cannot be factorized throws numerical_error.
 template <class Backend, class Sensor>
 std::vector<PredictedLandmark> predict_landmarks_in_view(const Backend& backend, const Sensor& sensor, const StereoRig& rig,
-                                                         int width, int height) {
+                                                         int width, int height,
+                                                         GateCovariance gate = GateCovariance::joint_marginal) {
   using Prediction = decltype(sensor.predict(pose_mean_of(backend), Eigen::Vector3d{}));
   const auto robot = pose_mean_of(backend);
   std::vector<LandmarkId> in_view;
   std::vector<Prediction> predictions;
-  for (const auto& [id, mean] : backend.landmark_means()) {
+  const auto means = [&] {
+    if constexpr (requires { backend.linearization_means(); })
+      return backend.linearization_means();
+    else
+      return backend.landmark_means();
+  }();
+  for (const auto& [id, mean] : means) {
     std::optional<Prediction> p;
     try {
       p = sensor.predict(robot, mean);
@@ -103,15 +124,24 @@ std::vector<PredictedLandmark> predict_landmarks_in_view(const Backend& backend,
     predictions.push_back(std::move(*p));
   }
   std::vector<PredictedLandmark> out;
-  auto add = [&](std::size_t i, const Eigen::MatrixXd& cov, Eigen::Index a) {
+  auto add = [&](std::size_t i, const auto& cov, Eigen::Index a) {
     const auto& p = predictions[i];
     const Eigen::Matrix3d S = innovation_cross_block(cov, p.J_z_x, p.J_z_m, a, p.J_z_x, p.J_z_m, a) + p.Q;
     const Eigen::LLT<Eigen::Matrix3d> llt(S);
     if (llt.info() == Eigen::Success) out.push_back({in_view[i], p.z, llt.solve(Eigen::Matrix3d::Identity())});
   };
   if (in_view.empty()) return out;
+  const std::span<const LandmarkId> ids(in_view);
+  if constexpr (requires { backend.conditional_joints(ids); }) {
+    if (gate == GateCovariance::conditional) {
+      const auto blocks = backend.conditional_joints(ids);
+      const Eigen::Index landmark_row = predictions.front().J_z_x.cols();  // the robot's block comes first
+      for (std::size_t i = 0; i < in_view.size(); ++i) add(i, blocks[i], landmark_row);
+      return out;
+    }
+  }
   if constexpr (requires { backend.information_matrix(); }) {
-    const auto joint = backend.joint_marginal(std::span<const LandmarkId>(in_view));
+    const auto joint = backend.joint_marginal(ids);
     for (std::size_t i = 0; i < in_view.size(); ++i) add(i, joint.cov, joint.offset(i));
   } else {
     for (std::size_t i = 0; i < in_view.size(); ++i) {
@@ -130,9 +160,33 @@ struct FeaturePair {
   double distance, nis;
 };
 
+/// The features' indices sorted by their point's x (camera frame), and those x values in that order:
+/// a landmark's gate can only hold the features whose x lies within its reach of the landmark's.
+struct FeaturesByX {
+  std::vector<std::size_t> index;
+  std::vector<double> x;
+  explicit FeaturesByX(const StereoFrame& frame) : index(frame.features.size()) {
+    std::iota(index.begin(), index.end(), std::size_t{0});
+    std::sort(index.begin(), index.end(),
+              [&](std::size_t a, std::size_t b) { return frame.features[a].point.x() < frame.features[b].point.x(); });
+    x.reserve(index.size());
+    for (const std::size_t i : index) x.push_back(frame.features[i].point.x());
+  }
+};
+
+/// How far a point inside the gate can lie from the prediction: NIS = r^T S^-1 r <= gate implies
+/// |r|^2 <= gate lambda_max(S) = gate / lambda_min(S^-1) (a little more, so that rounding never drops one).
+inline double gate_reach(const Eigen::Matrix3d& S_inverse, double gate) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+  eigen.computeDirect(S_inverse, Eigen::EigenvaluesOnly);
+  const double smallest = eigen.eigenvalues()(0);
+  return smallest > 0.0 ? 1.000001 * std::sqrt(gate / smallest) : std::numeric_limits<double>::infinity();
+}
+
 /// Per feature, its nearest landmark descriptor among the landmarks whose gate it is inside, kept
 /// when within max_descriptor_distance and the ratio test against the second nearest; `gated[i]`:
-/// feature i is inside some gate.
+/// feature i is inside some gate. Each landmark tests only the features within its gate's reach
+/// along x (the same pairs as testing all, in the same order per feature).
 inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& frame, std::span<const PredictedLandmark> predicted,
                                                          const LandmarkAppearance& appearance,
                                                          const MapAssociationOptions& o, std::vector<bool>& gated) {
@@ -141,9 +195,13 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
   std::vector<FeaturePair> best(frame.features.size(), FeaturePair{0, 0, std::numeric_limits<double>::infinity(), 0.0});
   std::vector<double> second(frame.features.size(), std::numeric_limits<double>::infinity());
   const int norm = frame.descriptors.type() == CV_8U ? cv::NORM_HAMMING : cv::NORM_L2;
+  const FeaturesByX by_x(frame);
   for (std::size_t j = 0; j < predicted.size(); ++j) {
     const cv::Mat* descriptor = appearance.find(predicted[j].id);
-    for (std::size_t i = 0; i < frame.features.size(); ++i) {
+    const double reach = gate_reach(predicted[j].S_inverse, gate), x = predicted[j].z.x();
+    const auto first = std::lower_bound(by_x.x.begin(), by_x.x.end(), x - reach);
+    for (auto at = first; at != by_x.x.end() && *at <= x + reach; ++at) {
+      const std::size_t i = by_x.index[static_cast<std::size_t>(at - by_x.x.begin())];
       const Eigen::Vector3d r = frame.features[i].point - predicted[j].z;
       const double nis = r.dot(predicted[j].S_inverse * r);
       if (!(nis <= gate)) continue;

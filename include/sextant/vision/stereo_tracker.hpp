@@ -1,7 +1,7 @@
 #pragma once
 /// \file The full image-to-map step of the thesis's vSLAM framework: a filter through the bounded
 /// landmark pool tracks the camera (EKF-SLAM or SEIF-SLAM: any back-end with landmark_means() and
-/// joint_marginal()), and its predictions gate the association of each new stereo frame's features
+/// joint_marginal(); SEIF gates with its conditional blocks by default), and its predictions gate the association of each new stereo frame's features
 /// with the map (vision/map_association.hpp). The observations it hands to its back-end, with their
 /// landmark ids, are the front-end's output: other back-ends replay them
 /// (docs/results/globe_stereo.md says why one association serves them all).
@@ -32,6 +32,9 @@ struct StereoTrackerOptions {
   FrontEndOptions front_end{};
   LandmarkDescriptor descriptor = LandmarkDescriptor::first;
   MapAssociationOptions association{};
+  /// What the gate's S comes from; `conditional` changes only information-form back-ends (SEIF),
+  /// whose exact joint marginal of every landmark in view costs a factorization of Omega a frame.
+  GateCovariance gate_covariance = GateCovariance::conditional;
   PoolLimits pool{};
 };
 
@@ -83,7 +86,8 @@ class StereoTracker {
     backend_.predict(control, dt);
     out.times.backend = seconds_since(start);
     start = Clock::now();
-    const auto predicted = predict_landmarks_in_view(backend_, sensor_, front_end_.rig(), width_, height_);
+    const auto predicted = predict_landmarks_in_view(backend_, sensor_, front_end_.rig(), width_, height_,
+                                                     options_.gate_covariance);
     const auto association = associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance_,
                                               next_id_, options_.association);
     out.times.associate = seconds_since(start);

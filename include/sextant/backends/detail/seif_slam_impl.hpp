@@ -788,6 +788,28 @@ auto SeifSlam<Motion, Sensor>::joint_marginal(std::span<const LandmarkId> ids) c
 }
 
 template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::conditional_joints(std::span<const LandmarkId> ids) const
+    -> std::vector<Eigen::Matrix<double, X + M, X + M>> {
+  using Block = Eigen::Matrix<double, X + M, X + M>;
+  std::vector<Block> out;
+  out.reserve(ids.size());
+  for (const LandmarkId id : ids) {
+    const std::size_t slot = landmarks_.slot(id);
+    Block omega;
+    omega.template topLeftCorner<X, X>() = info_.robot();
+    omega.template topRightCorner<X, M>() = info_.robot_link(slot);
+    omega.template bottomLeftCorner<M, X>() = info_.robot_link(slot).transpose();
+    omega.template bottomRightCorner<M, M>() = info_.diagonal(slot);
+    const Eigen::LLT<Block> llt(omega);
+    if (llt.info() != Eigen::Success || !omega.allFinite())
+      throw numerical_error("information block of the robot and landmark " + std::to_string(id) +
+                            " is not positive definite");
+    out.push_back(llt.solve(Block::Identity()));
+  }
+  return out;
+}
+
+template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::pose() const -> PoseEstimate {
   return {estimated_pose_mean(), marginal_covariance(0, X)};
 }
