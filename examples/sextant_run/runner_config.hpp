@@ -62,6 +62,7 @@ struct GlobeSettings {
   bool tracker_exact_gate = false;
   int octave_layers = 4;            ///< globe-stereo, stereo:DIR: AKAZE's sublevels per octave (vision::DetectorOptions)
   double detector_threshold = 0.001;  ///< globe-stereo, stereo:DIR: AKAZE's response threshold
+  bool row_search = false;  ///< [globe] stereo_correspondence = row_search: no detection in the right image
 };
 
 /// The visual-inertial runs' settings (run_vislam.cpp): the models' noise for .npz data (the
@@ -282,6 +283,14 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) { c.globe.octave_layers = parse_integer<int>(v, 1, 16); }},
       {"globe", "detector_threshold", "0.001", "globe-stereo, stereo:DIR: AKAZE's response threshold (OpenCV's default)",
        [](RunnerConfig& c, const std::string& v) { c.globe.detector_threshold = positive(parse_number(v), v); }},
+      {"globe", "stereo_correspondence", "detect_both",
+       "globe-stereo, stereo:DIR: detect_both (AKAZE in both images, matched along the rows by descriptor) | "
+       "row_search (AKAZE in the left image only, each keypoint found along its row in the right by correlation)",
+       [](RunnerConfig& c, const std::string& v) {
+         if (v != "detect_both" && v != "row_search")
+           throw invalid_input_error("'" + v + "' is not a stereo correspondence (detect_both or row_search)");
+         c.globe.row_search = v == "row_search";
+       }},
       {"globe", "graph_updates", "10", "GraphSLAM global updates after the windowed initialization (thesis Table 10: 10)",
        [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = parse_integer<int>(v, 1, 1e4); }},
       {"globe", "graph", "batch",

@@ -135,6 +135,7 @@ vision::StereoTrackerOptions tracker_options(const RunnerConfig& c) {
   o.association.max_observations = static_cast<std::size_t>(c.globe.features_per_frame);
   o.front_end.detector.octave_layers = c.globe.octave_layers;
   o.front_end.detector.threshold = static_cast<float>(c.globe.detector_threshold);
+  if (c.globe.row_search) o.front_end.correspondence = vision::StereoCorrespondence::row_search;
   o.gate_covariance = c.globe.tracker_exact_gate ? vision::GateCovariance::joint_marginal : vision::GateCovariance::conditional;
   return o;
 }

@@ -13,15 +13,23 @@
 #include <vector>
 
 #include "sextant/vision/features.hpp"
+#include "sextant/vision/row_search_matching.hpp"
 #include "sextant/vision/stereo_matching.hpp"
 #include "sextant/vision/stereo_triangulation.hpp"
 
 namespace sextant::vision {
 
+/// Where a left feature's partner comes from: a feature detected in the right image too (matched
+/// along the rows by descriptor), or a correlation search along the right image's row (no right
+/// detection: half the detector's work).
+enum class StereoCorrespondence { detect_both, row_search };
+
 struct FrontEndOptions {
   DetectorOptions detector{};
   StereoMatchOptions matching{};
-  bool parallel_detection = true;  ///< left and right on two threads
+  bool parallel_detection = true;  ///< detect_both: left and right on two threads
+  StereoCorrespondence correspondence = StereoCorrespondence::detect_both;
+  RowSearchOptions row_search{};   ///< row_search's settings
 };
 
 /// One stereo match as a measurement.
@@ -60,16 +68,27 @@ class StereoFrontEnd {
     using Clock = std::chrono::steady_clock;
     StereoFrame out;
     auto start = Clock::now();
-    const auto [left_features, right_features] = detect_both(left, right);
-    out.left_keypoints = left_features.keypoints.size();
-    out.right_keypoints = right_features.keypoints.size();
     auto lap = [&](double& seconds) {
       const auto now = Clock::now();
       seconds = std::chrono::duration<double>(now - start).count();
       start = now;
     };
-    lap(out.times.detect);
-    auto matches = match_stereo(left_features, right_features, options_.matching);
+    Features left_features;
+    std::vector<StereoMatch> matches;
+    if (options_.correspondence == StereoCorrespondence::row_search) {
+      if (right.type() != CV_8UC1) throw invalid_input_error("stereo front-end: the right image is not 8-bit grayscale");
+      left_features = detect(left, *left_);
+      out.left_keypoints = left_features.keypoints.size();
+      lap(out.times.detect);
+      matches = search_rows(left, right, left_features, options_.row_search);
+    } else {
+      auto [l, r] = detect_both(left, right);
+      left_features = std::move(l);
+      out.left_keypoints = left_features.keypoints.size();
+      out.right_keypoints = r.keypoints.size();
+      lap(out.times.detect);
+      matches = match_stereo(left_features, r, options_.matching);
+    }
     strongest_first(matches, left_features);
     lap(out.times.match);
     triangulate_matches(matches, left_features, out);
