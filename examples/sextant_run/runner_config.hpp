@@ -14,6 +14,7 @@
 #include <limits>
 #include <filesystem>
 #include <functional>
+#include <initializer_list>
 #include <mrpt/config/CConfigFile.h>
 #include <numbers>
 #include <optional>
@@ -142,6 +143,18 @@ inline double parse_number(const std::string& text) {
   return *value;
 }
 
+/// `text` when it is one of `choices`; else invalid_input_error "'text' is not a WHAT (a, b or c)".
+inline const std::string& one_of(const std::string& text, std::initializer_list<const char*> choices, const char* what) {
+  std::string list;
+  std::size_t k = 0;
+  for (const char* choice : choices) {
+    if (text == choice) return text;
+    list += (k == 0 ? "" : k + 1 == choices.size() ? " or " : ", ") + std::string(choice);
+    ++k;
+  }
+  throw invalid_input_error("'" + text + "' is not a " + what + " (" + list + ")");
+}
+
 /// An integer of type T in [min, max], max at most T's largest value or 2^53 (the largest up to which
 /// every integer is a double), whichever is smaller: no value is silently truncated. Counts that
 /// size memory (steps, particles, landmarks) pass their documented limit as `limit`
@@ -266,17 +279,14 @@ inline const std::vector<ConfigKey>& config_keys() {
        "globe-stereo, stereo:DIR: the back-end that tracks the images and gates the association: ekf, seif (its "
        "first seif_active value, [seif]'s sparsification) or eseif (relocalizing, its first eseif_active value)",
        [](RunnerConfig& c, const std::string& v) {
-         if (v != "ekf" && v != "seif" && v != "eseif")
-           throw invalid_input_error("'" + v + "' is not a tracker (ekf, seif or eseif)");
+         one_of(v, {"ekf", "seif", "eseif"}, "tracker");
          c.globe.tracker = v == "ekf" ? BackendKind::ekf : v == "seif" ? BackendKind::seif : BackendKind::eseif;
        }},
       {"globe", "tracker_gate", "conditional",
        "a SEIF tracker's gate: conditional (the robot and each landmark given the rest of the map, O(1) per "
        "landmark) | joint_marginal (exact: one solve with the factor of Omega a frame)",
        [](RunnerConfig& c, const std::string& v) {
-         if (v != "conditional" && v != "joint_marginal")
-           throw invalid_input_error("'" + v + "' is not a tracker gate (conditional or joint_marginal)");
-         c.globe.tracker_exact_gate = v == "joint_marginal";
+         c.globe.tracker_exact_gate = one_of(v, {"conditional", "joint_marginal"}, "tracker gate") == "joint_marginal";
        }},
       {"globe", "octave_layers", "4",
        "globe-stereo, stereo:DIR: AKAZE's sublevels per octave (OpenCV's default 4; its time is mostly building them)",
@@ -287,9 +297,7 @@ inline const std::vector<ConfigKey>& config_keys() {
        "globe-stereo, stereo:DIR: detect_both (AKAZE in both images, matched along the rows by descriptor) | "
        "row_search (AKAZE in the left image only, each keypoint found along its row in the right by correlation)",
        [](RunnerConfig& c, const std::string& v) {
-         if (v != "detect_both" && v != "row_search")
-           throw invalid_input_error("'" + v + "' is not a stereo correspondence (detect_both or row_search)");
-         c.globe.row_search = v == "row_search";
+         c.globe.row_search = one_of(v, {"detect_both", "row_search"}, "stereo correspondence") == "row_search";
        }},
       {"globe", "graph_updates", "10", "GraphSLAM global updates after the windowed initialization (thesis Table 10: 10)",
        [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = parse_integer<int>(v, 1, 1e4); }},
@@ -297,8 +305,7 @@ inline const std::vector<ConfigKey>& config_keys() {
        "batch (the thesis's: record, then global updates) | online (one incremental Gauss-Newton step a frame, "
        "[graph] relinearize_threshold) | both (a row each)",
        [](RunnerConfig& c, const std::string& v) {
-         if (v != "batch" && v != "online" && v != "both")
-           throw invalid_input_error("'" + v + "' is not a GraphSLAM mode (batch, online or both)");
+         one_of(v, {"batch", "online", "both"}, "GraphSLAM mode");
          c.globe.graph_batch = v != "online";
          c.globe.graph_online = v != "batch";
        }},
