@@ -149,9 +149,8 @@ auto with_tracker(const RunnerConfig& c, const EulerCamera12D& motion, const Poi
   if (c.globe.tracker == BackendKind::seif || c.globe.tracker == BackendKind::eseif) {
     const bool relocalizing = c.globe.tracker == BackendKind::eseif;
     const auto& active = relocalizing ? c.globe.eseif_active : c.globe.seif_active;
-    if (active.empty())
-      throw invalid_input_error(std::string("[globe] tracker = ") + (relocalizing ? "eseif" : "seif") + " needs a [globe] " +
-                                (relocalizing ? "eseif_active" : "seif_active") + " value");
+    const std::string key = relocalizing ? "eseif" : "seif";
+    if (active.empty()) throw invalid_input_error("[globe] tracker = " + key + " needs a [globe] " + key + "_active value");
     SeifOptions seif = c.seif;
     seif.max_active = active.front();
     if (relocalizing) seif.sparsification = SeifSparsification::relocalization;

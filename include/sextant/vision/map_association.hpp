@@ -12,7 +12,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <span>
@@ -160,20 +159,6 @@ struct FeaturePair {
   double distance, nis;
 };
 
-/// The features' indices sorted by their point's x (camera frame), and those x values in that order:
-/// a landmark's gate can only hold the features whose x lies within its reach of the landmark's.
-struct FeaturesByX {
-  std::vector<std::size_t> index;
-  std::vector<double> x;
-  explicit FeaturesByX(const StereoFrame& frame) : index(frame.features.size()) {
-    std::iota(index.begin(), index.end(), std::size_t{0});
-    std::sort(index.begin(), index.end(),
-              [&](std::size_t a, std::size_t b) { return frame.features[a].point.x() < frame.features[b].point.x(); });
-    x.reserve(index.size());
-    for (const std::size_t i : index) x.push_back(frame.features[i].point.x());
-  }
-};
-
 /// How far a point inside the gate can lie from the prediction: NIS = r^T S^-1 r <= gate implies
 /// |r|^2 <= gate lambda_max(S) = gate / lambda_min(S^-1) (a little more, so that rounding never drops one).
 inline double gate_reach(const Eigen::Matrix3d& S_inverse, double gate) {
@@ -195,13 +180,15 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
   std::vector<FeaturePair> best(frame.features.size(), FeaturePair{0, 0, std::numeric_limits<double>::infinity(), 0.0});
   std::vector<double> second(frame.features.size(), std::numeric_limits<double>::infinity());
   const int norm = frame.descriptors.type() == CV_8U ? cv::NORM_HAMMING : cv::NORM_L2;
-  const FeaturesByX by_x(frame);
+  std::vector<double> xs;  // a landmark's gate can only hold the features whose x lies within its reach
+  xs.reserve(frame.features.size());
+  for (const StereoFeature& f : frame.features) xs.push_back(f.point.x());
+  const SortedIndex by_x(xs);
   for (std::size_t j = 0; j < predicted.size(); ++j) {
     const cv::Mat* descriptor = appearance.find(predicted[j].id);
     const double reach = gate_reach(predicted[j].S_inverse, gate), x = predicted[j].z.x();
-    const auto first = std::lower_bound(by_x.x.begin(), by_x.x.end(), x - reach);
-    for (auto at = first; at != by_x.x.end() && *at <= x + reach; ++at) {
-      const std::size_t i = by_x.index[static_cast<std::size_t>(at - by_x.x.begin())];
+    for (const int feature : by_x.band(x, reach)) {
+      const auto i = static_cast<std::size_t>(feature);
       const Eigen::Vector3d r = frame.features[i].point - predicted[j].z;
       const double nis = r.dot(predicted[j].S_inverse * r);
       if (!(nis <= gate)) continue;

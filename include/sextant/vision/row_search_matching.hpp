@@ -53,7 +53,6 @@ class RightImage {
     cv::integral(right, sum_, squares_, CV_64F, CV_64F);
   }
   int cols() const { return levels_.cols; }
-  int rows() const { return levels_.rows; }
   const float* row(int y) const { return levels_.ptr<float>(y); }
   /// Sum of the levels and of their squares over the window of `size` x `size` px at (x, y).
   std::pair<double, double> window_sums(int x, int y, int size) const {

@@ -76,7 +76,6 @@ class StereoFrontEnd {
     Features left_features;
     std::vector<StereoMatch> matches;
     if (options_.correspondence == StereoCorrespondence::row_search) {
-      if (right.type() != CV_8UC1) throw invalid_input_error("stereo front-end: the right image is not 8-bit grayscale");
       left_features = detect(left, *left_);
       out.left_keypoints = left_features.keypoints.size();
       lap(out.times.detect);

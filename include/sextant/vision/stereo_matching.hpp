@@ -43,31 +43,39 @@ inline bool on_epipolar_segment(const Eigen::Vector2d& left, const Eigen::Vector
   return std::abs(left.y() - right.y()) <= o.max_row_difference && disparity > 0.0 && disparity <= o.max_disparity;
 }
 
-/// The keypoints of one image sorted by row, so that the candidates on an epipolar band are found
-/// by binary search instead of a scan of the whole image.
-class RowIndex {
+/// Indices 0 .. n-1 sorted by a key each (a keypoint's row, a point's x), so that those whose key lies
+/// within a tolerance of a value are found by binary search instead of a scan of all.
+class SortedIndex {
  public:
-  explicit RowIndex(const Features& f) : order_(f.keypoints.size()) {
+  explicit SortedIndex(const std::vector<double>& keys) : order_(keys.size()) {
     for (std::size_t j = 0; j < order_.size(); ++j) order_[j] = static_cast<int>(j);
     std::sort(order_.begin(), order_.end(),
-              [&](int a, int b) { return f.keypoints[static_cast<std::size_t>(a)].pt.y < f.keypoints[static_cast<std::size_t>(b)].pt.y; });
-    rows_.reserve(order_.size());
-    for (int j : order_) rows_.push_back(f.keypoints[static_cast<std::size_t>(j)].pt.y);
+              [&](int a, int b) { return keys[static_cast<std::size_t>(a)] < keys[static_cast<std::size_t>(b)]; });
+    keys_.reserve(order_.size());
+    for (int j : order_) keys_.push_back(keys[static_cast<std::size_t>(j)]);
   }
-  /// Keypoint indices with |row - v| <= tolerance.
-  std::span<const int> band(double v, double tolerance) const {
-    const auto lo = std::lower_bound(rows_.begin(), rows_.end(), v - tolerance);
-    const auto hi = std::upper_bound(lo, rows_.end(), v + tolerance);
-    return {order_.data() + (lo - rows_.begin()), static_cast<std::size_t>(hi - lo)};
+  /// Indices with |key - value| <= tolerance, in the order of their keys.
+  std::span<const int> band(double value, double tolerance) const {
+    const auto lo = std::lower_bound(keys_.begin(), keys_.end(), value - tolerance);
+    const auto hi = std::upper_bound(lo, keys_.end(), value + tolerance);
+    return {order_.data() + (lo - keys_.begin()), static_cast<std::size_t>(hi - lo)};
   }
 
  private:
   std::vector<int> order_;
-  std::vector<double> rows_;
+  std::vector<double> keys_;
 };
 
+/// The keypoints of one image sorted by row: the candidates on an epipolar band.
+inline SortedIndex row_index(const Features& f) {
+  std::vector<double> rows;
+  rows.reserve(f.keypoints.size());
+  for (const cv::KeyPoint& k : f.keypoints) rows.push_back(k.pt.y);
+  return SortedIndex(rows);
+}
+
 /// For feature i of `from`, the best candidate of `to` that passes the ratio test, or -1.
-inline int best_partner(const Features& from, int i, const Features& to, const RowIndex& to_rows,
+inline int best_partner(const Features& from, int i, const Features& to, const SortedIndex& to_rows,
                         const StereoMatchOptions& o, bool from_is_left, double& best_distance) {
   double best = std::numeric_limits<double>::infinity(), second = best;
   int best_j = -1;
@@ -95,7 +103,7 @@ inline int best_partner(const Features& from, int i, const Features& to, const R
 inline std::vector<StereoMatch> match_stereo(const Features& left, const Features& right, const StereoMatchOptions& o = {}) {
   std::vector<StereoMatch> out;
   if (left.keypoints.empty() || right.keypoints.empty()) return out;
-  const detail::RowIndex left_rows(left), right_rows(right);
+  const detail::SortedIndex left_rows = detail::row_index(left), right_rows = detail::row_index(right);
   for (int i = 0; i < static_cast<int>(left.keypoints.size()); ++i) {
     double distance = 0.0, back_distance = 0.0;
     const int j = detail::best_partner(left, i, right, right_rows, o, true, distance);

@@ -1,8 +1,8 @@
 #pragma once
 /// \file The full image-to-map step of the thesis's vSLAM framework: a filter through the bounded
 /// landmark pool tracks the camera (EKF-SLAM or SEIF-SLAM: any back-end with landmark_means() and
-/// joint_marginal(); SEIF gates with its conditional blocks by default), and its predictions gate the association of each new stereo frame's features
-/// with the map (vision/map_association.hpp). The observations it hands to its back-end, with their
+/// joint_marginal(); SEIF gates with its conditional blocks by default), and its predictions gate
+/// the association of each new stereo frame's features with the map (vision/map_association.hpp). The observations it hands to its back-end, with their
 /// landmark ids, are the front-end's output: other back-ends replay them
 /// (docs/results/globe_stereo.md says why one association serves them all).
 
