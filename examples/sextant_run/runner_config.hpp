@@ -64,6 +64,8 @@ struct GlobeSettings {
   int octave_layers = 4;            ///< globe-stereo, stereo:DIR: AKAZE's sublevels per octave (vision::DetectorOptions)
   double detector_threshold = 0.001;  ///< globe-stereo, stereo:DIR: AKAZE's response threshold
   bool row_search = false;  ///< [globe] stereo_correspondence = row_search: no detection in the right image
+  bool pipelined = true;    ///< globe-stereo, stereo:DIR: frame k+1's front-end during frame k's filter half
+  int opencv_threads = 1;   ///< globe-stereo, stereo:DIR: cv::setNumThreads during the run (0: OpenCV's default)
 };
 
 /// The visual-inertial runs' settings (run_vislam.cpp): the models' noise for .npz data (the
@@ -299,6 +301,14 @@ inline const std::vector<ConfigKey>& config_keys() {
        [](RunnerConfig& c, const std::string& v) {
          c.globe.row_search = one_of(v, {"detect_both", "row_search"}, "stereo correspondence") == "row_search";
        }},
+      {"globe", "pipelined", "true",
+       "globe-stereo, stereo:DIR: true (frame k+1's features found on a second thread while frame k is associated "
+       "and filtered, as a live camera allows; the same results) | false (one frame after another)",
+       [](RunnerConfig& c, const std::string& v) { c.globe.pipelined = parse_bool(v); }},
+      {"globe", "opencv_threads", "1",
+       "globe-stereo, stereo:DIR: OpenCV's worker threads inside AKAZE (0 = OpenCV's default, one per core); the "
+       "pipeline and the two images on two threads keep the cores busy already",
+       [](RunnerConfig& c, const std::string& v) { c.globe.opencv_threads = parse_integer<int>(v, 0, 256); }},
       {"globe", "graph_updates", "10", "GraphSLAM global updates after the windowed initialization (thesis Table 10: 10)",
        [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = parse_integer<int>(v, 1, 1e4); }},
       {"globe", "graph", "batch",

@@ -20,6 +20,7 @@
 #include "sextant/eval/globe_association_truth.hpp"
 #include "sextant/vision/gray_image_view.hpp"
 #include "sextant/vision/stereo_sequence.hpp"
+#include "sextant/vision/stereo_sequence_tracking.hpp"
 #include "sextant/vision/stereo_tracker.hpp"
 
 namespace sextant::vision {
@@ -228,6 +229,50 @@ void expect_parse_error_naming(const std::filesystem::path& dir, const std::stri
 }
 
 void write_text(const std::filesystem::path& file, const std::string& text) { std::ofstream(file) << text; }
+
+/// Frame k+1's front-end on a second thread while frame k is filtered gives, frame for frame, what
+/// one frame after another gives (the front-end reads no filter state); a bad pair stops both after
+/// the same frames, with the caller told of every frame the tracker took in.
+TEST(GlobeStereoPipeline, PipelinedTrackingGivesTheFramesOfOneAfterAnother) {
+  sim::GlobeCameraOptions o;
+  o.num_steps = 8;
+  const auto data = sim::simulate_globe_camera(o);
+  std::vector<StereoPair> pairs;
+  for (int k = 0; k < o.num_steps; ++k) {
+    const auto images = sim::render_stereo(o, data.true_poses[static_cast<std::size_t>(k) + 1]);
+    pairs.push_back({as_mat(images.left).clone(), as_mat(images.right).clone()});
+  }
+  auto run = [&](bool pipelined, std::size_t bad_pair) {
+    Tracker tracker(Ekf(data.motion, data.sensor, data.prior), data.sensor, rig_of(o), o.image_width, o.image_height);
+    std::vector<TrackedFrame> seen;
+    auto pair_of = [&](std::size_t k) { return k == bad_pair ? StereoPair{pairs[k].left, cv::Mat(10, 10, CV_8UC1)} : pairs[k]; };
+    bool threw = false;
+    try {
+      track_sequence(tracker, pairs.size(), pair_of, [&](std::size_t) { return o.dt; },
+                     [&](std::size_t, const TrackedFrame& f) { seen.push_back(f); }, pipelined);
+    } catch (const invalid_input_error&) {
+      threw = true;
+    }
+    EXPECT_EQ(threw, bad_pair < pairs.size());
+    return std::pair{seen, tracker.backend().pose()};
+  };
+  for (const std::size_t bad_pair : {pairs.size(), std::size_t{5}}) {
+    const auto [one_by_one, one_by_one_pose] = run(false, bad_pair);
+    const auto [pipelined, pipelined_pose] = run(true, bad_pair);
+    ASSERT_EQ(one_by_one.size(), std::min(bad_pair, pairs.size()));
+    ASSERT_EQ(pipelined.size(), one_by_one.size());
+    for (std::size_t k = 0; k < one_by_one.size(); ++k) {
+      ASSERT_EQ(pipelined[k].observations.size(), one_by_one[k].observations.size()) << "frame " << k;
+      EXPECT_GT(one_by_one[k].observations.size(), 0u) << "frame " << k;
+      for (std::size_t i = 0; i < one_by_one[k].observations.size(); ++i) {
+        EXPECT_EQ(pipelined[k].observations[i].landmark_id, one_by_one[k].observations[i].landmark_id);
+        EXPECT_EQ(pipelined[k].observations[i].z, one_by_one[k].observations[i].z);
+      }
+    }
+    EXPECT_EQ(pipelined_pose.mean, one_by_one_pose.mean);
+    EXPECT_EQ(pipelined_pose.cov, one_by_one_pose.cov);
+  }
+}
 
 TEST(StereoSequence, BadDirectoriesGiveOneErrorNamingTheFile) {
   const auto dir = small_sequence("stereo_bad");

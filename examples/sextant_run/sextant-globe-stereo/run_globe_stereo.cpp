@@ -16,6 +16,7 @@
 #include <sextant/eval/globe_association_truth.hpp>
 #include <sextant/vision/gray_image_view.hpp>
 #include <sextant/vision/stereo_sequence.hpp>
+#include <sextant/vision/stereo_sequence_tracking.hpp>
 #include <sextant/vision/stereo_tracker.hpp>
 #include <string>
 #include <vector>
@@ -51,7 +52,8 @@ struct FrontEndTotals {
   }
 };
 
-void print_front_end(const FrontEndTotals& t, const eval::GlobeAssociationTruth* truth, const std::string& tracker) {
+void print_front_end(const FrontEndTotals& t, const vision::SequenceClock& clock, const GlobeSettings& settings,
+                     const eval::GlobeAssociationTruth* truth, const std::string& tracker) {
   const double n = static_cast<double>(std::max<std::size_t>(t.frames, 1));
   std::printf("front-end over %zu frames: %.0f left keypoints, %.0f stereo matches, %.1f observations per frame "
               "(%.1f associated, %.1f proposed as new)",
@@ -59,12 +61,17 @@ void print_front_end(const FrontEndTotals& t, const eval::GlobeAssociationTruth*
   if (truth)
     std::printf("; association precision %.4f (%zu of %zu right against the rendering)", truth->precision(),
                 truth->right(), truth->associated());
-  std::printf("\n%-12s %9s %9s %11s %10s %12s %9s %10s\n", "ms/frame", "detect", "match", "triangulate", "associate",
-              (tracker + " back-end").c_str(), "total", "frames/s");
+  std::printf("\n%-12s %9s %9s %11s %10s %12s %9s %11s %10s\n", "ms/frame", "detect", "match", "triangulate",
+              "associate", (tracker + " back-end").c_str(), "stages", "wall clock", "frames/s");
   const auto& s = t.times;
-  std::printf("%-12s %9.2f %9.2f %11.3f %10.2f %12.2f %9.2f %10.2f\n", "", 1e3 * s.detect / n, 1e3 * s.match / n,
-              1e3 * s.triangulate / n, 1e3 * s.associate / n, 1e3 * s.backend / n, 1e3 * s.total() / n,
-              n / std::max(s.total(), 1e-12));
+  std::printf("%-12s %9.2f %9.2f %11.3f %10.2f %12.2f %9.2f %11.2f %10.2f\n", "", 1e3 * s.detect / n,
+              1e3 * s.match / n, 1e3 * s.triangulate / n, 1e3 * s.associate / n, 1e3 * s.backend / n,
+              1e3 * s.total() / n, 1e3 * clock.seconds / n, clock.frames_per_second());
+  std::printf("(%s; [globe] pipelined = %s, opencv_threads = %d)\n",
+              settings.pipelined ? "pipelined: frame k+1's detect, match and triangulate on a second thread while "
+                                   "frame k is associated and filtered, so the stages overlap and share the cores"
+                                 : "one frame after another",
+              settings.pipelined ? "true" : "false", settings.opencv_threads);
   if (t.render > 0.0) std::printf("(rendering, not part of the pipeline: %.1f ms per stereo pair)\n", 1e3 * t.render / n);
 }
 
@@ -163,6 +170,28 @@ auto with_tracker(const RunnerConfig& c, const EulerCamera12D& motion, const Poi
   return run(tracker, std::string("EKF"));
 }
 
+/// OpenCV's worker threads set for a run's duration and restored after it; 0 leaves OpenCV's setting.
+class OpenCvThreads {
+ public:
+  explicit OpenCvThreads(int threads) : previous_(cv::getNumThreads()) {
+    if (threads > 0) cv::setNumThreads(threads);
+  }
+  ~OpenCvThreads() { cv::setNumThreads(previous_); }
+  OpenCvThreads(const OpenCvThreads&) = delete;
+  OpenCvThreads& operator=(const OpenCvThreads&) = delete;
+
+ private:
+  int previous_;
+};
+
+/// The sequence through the tracker as [globe] pipelined and opencv_threads say (vision::track_sequence).
+template <class Tracker, class PairOf, class DtOf, class OnFrame>
+vision::SequenceClock track_frames(Tracker& tracker, std::size_t n, PairOf&& pair_of, DtOf&& dt_of, OnFrame&& on_frame,
+                                   const RunnerConfig& config) {
+  const OpenCvThreads threads(config.globe.opencv_threads);
+  return vision::track_sequence(tracker, n, pair_of, dt_of, on_frame, config.globe.pipelined);
+}
+
 vision::StereoCalibration calibration_of(const sim::GlobeCameraOptions& o, const Gaussian<Vector12d, 12>& prior) {
   vision::StereoCalibration c;
   c.K << o.stereo.focal_px, 0, 0.5 * o.image_width, 0, o.stereo.focal_px, 0.5 * o.image_height, 0, 0, 1;
@@ -201,25 +230,29 @@ std::vector<TableRow> run_globe_stereo(const CliOptions& cli, const std::string&
     PictureFrame picture;
     const std::size_t picture_step = std::min<std::size_t>(100, points.steps.size() - 1);
     ProgressBar progress("globe-stereo: render + front-end", points.steps.size());
-    for (std::size_t k = 0; k < points.steps.size(); ++k) {
-      const Vector12d& x = points.true_poses[k + 1];
+    auto render = [&](std::size_t k) {
       const auto start = std::chrono::steady_clock::now();
-      const auto images = sim::render_stereo(o, x);
+      const auto images = sim::render_stereo(o, points.true_poses[k + 1]);
       totals.render += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const cv::Mat left = vision::as_mat(images.left), right = vision::as_mat(images.right);
-      if (!save_images.empty()) vision::write_stereo_pair(save_images, k, left, right);
-      const auto tracked = tracker.track(left, right, {}, points.steps[k].dt);
-      truth.score(x, tracked);
+      vision::StereoPair pair{vision::as_mat(images.left).clone(), vision::as_mat(images.right).clone()};
+      if (!save_images.empty()) vision::write_stereo_pair(save_images, k, pair.left, pair.right);
+      if (k == picture_step) picture.left = pair.left, picture.right = pair.right;
+      return pair;
+    };
+    auto record = [&](std::size_t k, const vision::TrackedFrame& tracked) {
+      truth.score(points.true_poses[k + 1], tracked);
       totals.add(tracked);
       stereo.steps[k].observations = tracked.observations;
       frames.push_back(tracked.observations);
       is_new.push_back(tracked.is_new);
       tracked_means.push_back(pose_mean_of(tracker.backend()));
-      if (k == picture_step) picture = {left.clone(), right.clone(), tracked};
+      if (k == picture_step) picture.tracked = tracked;
       progress.advance();
-    }
+    };
+    const auto clock = track_frames(tracker, points.steps.size(), render,
+                                    [&](std::size_t k) { return points.steps[k].dt; }, record, config);
     stereo.true_landmarks = truth.true_landmarks();
-    print_front_end(totals, &truth, tracker_name);
+    print_front_end(totals, clock, config.globe, &truth, tracker_name);
     if (!save_images.empty()) std::printf("wrote the rendered sequence to %s (left/, right/, calib.yaml)\n", save_images.c_str());
     if (!options.out.empty()) write_observations(std::filesystem::path(options.out) / "globe-stereo", frames, is_new);
     if (options.plots) {
@@ -258,17 +291,20 @@ std::vector<TableRow> run_stereo_directory(const CliOptions& cli, const std::str
     std::vector<std::vector<bool>> is_new;
     std::vector<io::TumPose> trajectory;
     ProgressBar progress("stereo: front-end", sequence.size());
-    for (std::size_t k = 0; k < sequence.size(); ++k) {
-      const auto [left, right] = sequence.load(k);
-      const auto tracked = tracker.track(left, right, {}, c.dt);
+    auto load = [&](std::size_t k) {
+      auto [left, right] = sequence.load(k);
+      return vision::StereoPair{std::move(left), std::move(right)};
+    };
+    auto record = [&](std::size_t k, const vision::TrackedFrame& tracked) {
       totals.add(tracked);
       frames.push_back(tracked.observations);
       is_new.push_back(tracked.is_new);
       const Vector12d x = pose_mean_of(tracker.backend());
       trajectory.push_back({c.dt * static_cast<double>(k + 1), x.head<3>(), Eigen::Quaterniond(euler_yxz::rotation(x.segment<3>(3)))});
       progress.advance();
-    }
-    print_front_end(totals, nullptr, tracker_name);
+    };
+    const auto clock = track_frames(tracker, sequence.size(), load, [&](std::size_t) { return c.dt; }, record, config);
+    print_front_end(totals, clock, config.globe, nullptr, tracker_name);
     std::printf("%s at the end: %zu landmarks in the map; no ground truth with a stereo directory, so no error columns\n",
                 tracker_name.c_str(), tracker.backend().landmark_ids().size());
     if (!options.out.empty()) {

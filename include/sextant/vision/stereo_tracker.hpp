@@ -64,18 +64,31 @@ class StereoTracker {
       : sensor_(sensor), backend_(std::move(backend)), policy_(options.pool), front_end_(rig, options.front_end),
         width_(width), height_(height), options_(options) {}
 
-  /// One frame: features of the pair, motion update over dt, association, pool, measurement update.
-  /// Bad images (empty, not 8-bit, sizes that differ) throw invalid_input_error before anything
-  /// changes; the back-end's own steps keep their strong guarantee, but a failed measurement update
-  /// leaves the tracker after this frame's motion update, as eval::run_through_pool does.
+  /// One frame: features of the pair, motion update over dt, association, pool, measurement update
+  /// (observe, then incorporate). Bad images (empty, not 8-bit, sizes that differ) throw
+  /// invalid_input_error before anything changes; the back-end's own steps keep their strong
+  /// guarantee, but a failed measurement update leaves the tracker after this frame's motion update,
+  /// as eval::run_through_pool does.
   TrackedFrame track(const cv::Mat& left, const cv::Mat& right, const Control& control, double dt) {
-    using Clock = std::chrono::steady_clock;
-    TrackedFrame out;
+    return incorporate(observe(left, right), control, dt);
+  }
+
+  /// The front-end's half of a frame (detect, match, triangulate). It reads nothing incorporate
+  /// writes, so the next frame's may run on another thread while this one is incorporated
+  /// (vision/stereo_sequence_tracking.hpp). Throws as track does for bad images; changes nothing else.
+  StereoFrame observe(const cv::Mat& left, const cv::Mat& right) {
     if (left.cols != width_ || left.rows != height_)
       throw invalid_input_error("stereo tracker: a " + std::to_string(left.cols) + "x" + std::to_string(left.rows) +
                                 " image, but the camera's images are " + std::to_string(width_) + "x" +
                                 std::to_string(height_));
-    const StereoFrame frame = front_end_.process(left, right);
+    return front_end_.process(left, right);
+  }
+
+  /// The filter's half of a frame observed by observe: motion update over dt, association with the
+  /// map, pool, measurement update.
+  TrackedFrame incorporate(const StereoFrame& frame, const Control& control, double dt) {
+    using Clock = std::chrono::steady_clock;
+    TrackedFrame out;
     out.times.detect = frame.times.detect;
     out.times.match = frame.times.match;
     out.times.triangulate = frame.times.triangulate;
