@@ -238,328 +238,425 @@ inline AutoSwitch parse_auto_switch(const std::string& text) {
 
 }  // namespace detail
 
-/// Every key sextant-run understands.
-inline const std::vector<ConfigKey>& config_keys() {
-  using namespace detail;
+namespace detail {
+
+/// [ship]: the simulated 2D beacon ship's Monte Carlo runs.
+inline std::vector<ConfigKey> ship_keys() {
   constexpr double deg = std::numbers::pi / 180.0;
-  static const std::vector<ConfigKey> keys = {
-      {"ship", "seed", "1", "first simulation seed of the 2D beacon-ship Monte Carlo runs",
-       [](RunnerConfig& c, const std::string& v) { c.ship.seed = parse_integer<std::uint64_t>(v, 0); }},
-      {"ship", "runs", "10", "Monte Carlo runs (seeds seed .. seed+runs-1); the table averages them",
-       [](RunnerConfig& c, const std::string& v) { c.ship_runs = parse_integer<int>(v, 1, 1e5); }},
-      {"ship", "steps", "1390", "steps per run (thesis: 1390)",
-       [](RunnerConfig& c, const std::string& v) { c.ship.num_steps = parse_integer<int>(v, 1, 1e7); }},
-      {"ship", "sigma_heading_deg", "15", "compass noise, degrees (thesis: 15)",
-       [](RunnerConfig& c, const std::string& v) { c.ship.sigma_heading = positive(parse_number(v), v) * deg; }},
-      {"ship", "sigma_beacon", "2", "beacon offset noise per axis, km",
-       [](RunnerConfig& c, const std::string& v) { c.ship.sigma_beacon = positive(parse_number(v), v); }},
-      {"globe", "seed", "1", "simulation seed of the globe (12D camera) experiment",
-       [](RunnerConfig& c, const std::string& v) { c.globe.seed = parse_integer<std::uint64_t>(v, 0); }},
-      {"globe", "steps", "500", "steps (thesis: 500); the circle closes near step 420",
-       [](RunnerConfig& c, const std::string& v) { c.globe.steps = parse_integer<int>(v, 1, 1e6); }},
-      {"globe", "points", "3000", "feature points on the globe",
-       [](RunnerConfig& c, const std::string& v) { c.globe.points = parse_integer<int>(v, 1, 1e7); }},
-      {"globe", "features_per_frame", "120", "strongest visible points observed per frame",
-       [](RunnerConfig& c, const std::string& v) { c.globe.features_per_frame = parse_integer<int>(v, 1, 1e5); }},
-      {"globe", "response_jitter", "0",
-       "log-normal frame-to-frame noise of the detector's responses (0 = the same strongest points every frame; "
-       "1 with 20000 points and Mmax 10000: the thesis-scale run of docs/results/real_time.md)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.response_jitter = non_negative(parse_number(v), v); }},
-      {"globe", "max_landmarks", "1000", "landmark pool capacity Mmax (thesis: 1000)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_landmarks = parse_integer<std::size_t>(v, 1, 1e6); }},
-      {"globe", "max_new_per_step", "50", "new landmarks per step at most (thesis: 50)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_new_per_step = parse_integer<std::size_t>(v, 1, 1e6); }},
-      {"globe", "seif_active", "150 250 0", "SEIF runs, one per value: active landmarks (0 = all)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.seif_active = parse_active_counts(v, false); }},
-      {"globe", "eseif_active", "150 250",
-       "ESEIF runs (back-end eseif: SEIF with relocalization, consistent; docs/results/seif_relocalization.md), one "
-       "per value: active landmarks (at least 1); 'none' = no such run",
-       [](RunnerConfig& c, const std::string& v) { c.globe.eseif_active = parse_active_counts(v, true); }},
-      {"globe", "covariance_period", "10", "NEES of the pose every this many steps (a SEIF's covariance costs a factorization)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.covariance_period = parse_integer<std::size_t>(v, 1); }},
-      {"globe", "tracker", "ekf",
-       "globe-stereo, stereo:DIR: the back-end that tracks the images and gates the association: ekf, seif (its "
-       "first seif_active value, [seif]'s sparsification) or eseif (relocalizing, its first eseif_active value)",
-       [](RunnerConfig& c, const std::string& v) {
-         one_of(v, {"ekf", "seif", "eseif"}, "tracker");
-         c.globe.tracker = v == "ekf" ? BackendKind::ekf : v == "seif" ? BackendKind::seif : BackendKind::eseif;
-       }},
-      {"globe", "tracker_gate", "conditional",
-       "a SEIF tracker's gate: conditional (the robot and each landmark given the rest of the map, O(1) per "
-       "landmark) | joint_marginal (exact: one solve with the factor of Omega a frame)",
-       [](RunnerConfig& c, const std::string& v) {
-         c.globe.tracker_exact_gate = one_of(v, {"conditional", "joint_marginal"}, "tracker gate") == "joint_marginal";
-       }},
-      {"globe", "octave_layers", "4",
-       "globe-stereo, stereo:DIR: AKAZE's sublevels per octave (OpenCV's default 4; its time is mostly building them)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.octave_layers = parse_integer<int>(v, 1, 16); }},
-      {"globe", "detector_threshold", "0.001", "globe-stereo, stereo:DIR: AKAZE's response threshold (OpenCV's default)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.detector_threshold = positive(parse_number(v), v); }},
-      {"globe", "stereo_correspondence", "detect_both",
-       "globe-stereo, stereo:DIR: detect_both (AKAZE in both images, matched along the rows by descriptor) | "
-       "row_search (AKAZE in the left image only, each keypoint found along its row in the right by correlation)",
-       [](RunnerConfig& c, const std::string& v) {
-         c.globe.row_search = one_of(v, {"detect_both", "row_search"}, "stereo correspondence") == "row_search";
-       }},
-      {"globe", "pipelined", "true",
-       "globe-stereo, stereo:DIR: true (frame k+1's features found on a second thread while frame k is associated "
-       "and filtered, as a live camera allows; the same results) | false (one frame after another)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.pipelined = parse_bool(v); }},
-      {"globe", "opencv_threads", "1",
-       "globe-stereo, stereo:DIR: OpenCV's worker threads inside AKAZE (0 = OpenCV's default, one per core); the "
-       "pipeline and the two images on two threads keep the cores busy already",
-       [](RunnerConfig& c, const std::string& v) { c.globe.opencv_threads = parse_integer<int>(v, 0, 256); }},
-      {"globe", "graph_updates", "10", "GraphSLAM global updates after the windowed initialization (thesis Table 10: 10)",
-       [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = parse_integer<int>(v, 1, 1e4); }},
-      {"globe", "graph", "batch",
-       "batch (the thesis's: record, then global updates) | online (one incremental Gauss-Newton step a frame, "
-       "[graph] relinearize_threshold) | both (a row each)",
-       [](RunnerConfig& c, const std::string& v) {
-         one_of(v, {"batch", "online", "both"}, "GraphSLAM mode");
-         c.globe.graph_batch = v != "online";
-         c.globe.graph_online = v != "batch";
-       }},
-      {"vislam", "velocity_sigma", "0.5", "m/s: IMU linear velocity noise per axis (.npz data)",
-       [](RunnerConfig& c, const std::string& v) { c.vislam.velocity_sigma = positive(parse_number(v), v); }},
-      {"vislam", "rate_sigma", "0.05", "rad/s: IMU angular velocity noise per axis (.npz data)",
-       [](RunnerConfig& c, const std::string& v) { c.vislam.rate_sigma = positive(parse_number(v), v); }},
-      {"vislam", "pixel_sigma", "2", "px: stereo feature noise (.npz data)",
-       [](RunnerConfig& c, const std::string& v) { c.vislam.pixel_sigma = positive(parse_number(v), v); }},
-      {"vislam", "min_disparity", "2", "px: smallest disparity a new landmark is triangulated from (.npz data)",
-       [](RunnerConfig& c, const std::string& v) { c.vislam.min_disparity = non_negative(parse_number(v), v); }},
-      {"vislam", "max_landmarks", "150", "landmark pool capacity (EKF: <= 10 ms per frame on 03.npz)",
-       [](RunnerConfig& c, const std::string& v) { c.vislam.pool.max_landmarks = parse_integer<std::size_t>(v, 1, 1e6); }},
-      {"vislam", "max_new_per_step", "20", "new landmarks per frame at most",
-       [](RunnerConfig& c, const std::string& v) { c.vislam.pool.max_new_per_step = parse_integer<std::size_t>(v, 1, 1e6); }},
-      {"vislam", "gate_probability", "0.999", "Mahalanobis gate of the filters (0 = off)",
-       [](RunnerConfig& c, const std::string& v) { c.vislam.gate_probability = parse_gate_probability(v); }},
-      {"vislam", "seed", "1", "simulation seed of stereo-vi",
-       [](RunnerConfig& c, const std::string& v) { c.vislam.seed = parse_integer<std::uint64_t>(v, 0); }},
-      {"vislam", "steps", "400", "stereo-vi frames (one loop)",
-       [](RunnerConfig& c, const std::string& v) { c.vislam.steps = parse_integer<int>(v, 1, 1e6); }},
-      {"rawlog", "std_range", "0", "range noise, m; 0 = as stated in the rawlog",
-       [](RunnerConfig& c, const std::string& v) {
-         const double x = non_negative(parse_number(v), v);
-         c.rawlog.std_range = x > 0.0 ? std::optional<double>(x) : std::nullopt;
-       }},
-      {"rawlog", "std_yaw_deg", "0", "bearing (yaw) noise, degrees; 0 = as stated in the rawlog",
-       [](RunnerConfig& c, const std::string& v) {
-         const double x = non_negative(parse_number(v), v);
-         c.rawlog.std_yaw = x > 0.0 ? std::optional<double>(x * deg) : std::nullopt;
-       }},
-      {"rawlog", "std_pitch_deg", "0", "pitch noise (3D), degrees; 0 = as stated in the rawlog",
-       [](RunnerConfig& c, const std::string& v) {
-         const double x = non_negative(parse_number(v), v);
-         c.rawlog.std_pitch = x > 0.0 ? std::optional<double>(x * deg) : std::nullopt;
-       }},
-      {"rawlog", "odometry_std_xy", "0.1", "observation-only rawlogs: odometry noise per step along x and y, m",
-       [](RunnerConfig& c, const std::string& v) {
-         c.rawlog.odometry_std(0) = c.rawlog.odometry_std(1) = positive(parse_number(v), v);
-       }},
-      {"rawlog", "odometry_std_phi_deg", "4", "observation-only rawlogs: odometry heading noise per step, degrees",
-       [](RunnerConfig& c, const std::string& v) { c.rawlog.odometry_std(2) = positive(parse_number(v), v) * deg; }},
-      {"rawlog", "prior_std", "1e-06", "standard deviation of the start pose (the robot starts at the map origin)",
-       [](RunnerConfig& c, const std::string& v) { c.rawlog.prior_std = positive(parse_number(v), v); }},
-      {"rawlog", "max_steps", "0", "read at most this many steps; 0 = all",
-       [](RunnerConfig& c, const std::string& v) { c.rawlog.max_steps = parse_integer<std::size_t>(v, 0); }},
-      {"mrclam", "max_step", "0.25", "MRCLAM: longest step without a measurement, s (steps also end at every measurement)",
-       [](RunnerConfig& c, const std::string& v) { c.mrclam.max_step = positive(parse_number(v), v); }},
-      {"mrclam", "odometry_delay", "0.2", "MRCLAM: seconds added to the odometry time stamps (Dataset6: 0.2 matches Vicon best)",
-       [](RunnerConfig& c, const std::string& v) {
-         const double d = parse_number(v);
-         if (!(std::abs(d) <= 10.0)) throw invalid_input_error("'" + v + "' must be in [-10, 10] s");
-         c.mrclam.odometry_delay = d;
-       }},
-      {"mrclam", "std_range", "0.15", "MRCLAM: range noise, m (robust SD against Vicon: 0.13)",
-       [](RunnerConfig& c, const std::string& v) { c.mrclam.measurement_sigma(0) = positive(parse_number(v), v); }},
-      {"mrclam", "std_bearing_deg", "1.146", "MRCLAM: bearing noise, degrees (robust SD against Vicon: 0.49)",
-       [](RunnerConfig& c, const std::string& v) { c.mrclam.measurement_sigma(1) = positive(parse_number(v), v) * deg; }},
-      {"mrclam", "alpha", "0.015 0.002 0.02 0.1 0 0.001",
-       "MRCLAM: velocity motion model noise a1..a6 (Thrun): var v = a1 v^2 + a2 w^2, var w = a3 v^2 + a4 w^2, final "
-       "turn a5 v^2 + a6 w^2",
-       [](RunnerConfig& c, const std::string& v) {
-         std::istringstream in(v);
-         std::vector<double> values;
-         for (std::string word; in >> word;) values.push_back(parse_number(word));
-         if (values.size() != 6 || std::any_of(values.begin(), values.end(), [](double a) { return a < 0.0; }))
-           throw invalid_input_error("'" + v + "' must be six non-negative numbers");
-         std::copy(values.begin(), values.end(), c.mrclam.motion.alpha.begin());
-       }},
-      {"mrclam", "gate_probability", "0.9999",
-       "MRCLAM: Mahalanobis gate of EKF, SEIF and FastSLAM (real data has outliers; 0 = off); overrides their own",
-       [](RunnerConfig& c, const std::string& v) { c.mrclam_gate_probability = parse_gate_probability(v); }},
-      {"mrclam", "reacquire_after_landmarks", "3",
-       "MRCLAM: the EKF re-acquires a pose lost beyond its covariance (with the gate on; 0 = never); overrides [ekf]",
-       [](RunnerConfig& c, const std::string& v) { c.mrclam_reacquire_after_landmarks = parse_integer<int>(v, 0, 1e6); }},
-      {"mrclam", "graph_robust_kernel", "cauchy", "MRCLAM: GraphSLAM's robust kernel (none | huber | cauchy); overrides [graph]",
-       [](RunnerConfig& c, const std::string& v) {
-         c.mrclam_graph_kernel = parse_choice<RobustKernel>(
-             v, {{"none", RobustKernel::none}, {"huber", RobustKernel::huber}, {"cauchy", RobustKernel::cauchy}});
-       }},
-      {"mrclam", "filters_in_world_frame", "true",
-       "MRCLAM: EKF and SEIF perturb the pose in the world frame (with the EKF's first-estimate Jacobians: no "
-       "spurious heading information); GraphSLAM and FastSLAM keep the additive chart",
-       [](RunnerConfig& c, const std::string& v) { c.mrclam_filters_in_world_frame = parse_bool(v); }},
-      {"association", "method", "known",
-       "known (the data set's ids) | nn (nearest neighbour) | jcbb (joint compatibility): ids withheld and found by "
-       "EKF and SEIF; FastSLAM associates per particle; GraphSLAM needs known ids",
-       [](RunnerConfig& c, const std::string& v) {
-         c.association.method = parse_choice<std::optional<AssociationMethod>>(
-             v, {{"known", std::nullopt},
-                 {"nn", AssociationMethod::nearest_neighbour},
-                 {"jcbb", AssociationMethod::joint_compatibility}});
-       }},
-      {"association", "gate_probability", "0.99", "chi-square gate of individual and joint compatibility",
-       [](RunnerConfig& c, const std::string& v) { c.association.options.gate_probability = parse_probability(v); }},
-      {"association", "new_landmark_probability", "0.9999",
-       "a measurement outside every landmark's gate at this probability starts a new landmark; inside one but unpaired "
-       "it is discarded",
-       [](RunnerConfig& c, const std::string& v) { c.association.options.new_landmark_probability = parse_probability(v); }},
-      {"ekf", "batch_update", "true", "one joint correction per step (true) or one per observation (false)",
-       [](RunnerConfig& c, const std::string& v) { c.ekf.batch_update = parse_bool(v); }},
-      {"ekf", "covariance_update", "symmetric", "symmetric (lower-triangle rank update) | joseph",
-       [](RunnerConfig& c, const std::string& v) {
-         c.ekf.covariance_update =
-             parse_choice<CovarianceUpdate>(v, {{"symmetric", CovarianceUpdate::symmetric}, {"joseph", CovarianceUpdate::joseph}});
-       }},
-      {"ekf", "first_estimate_jacobians", "auto",
-       "auto (on where the pose is perturbed in the world frame: MRCLAM) | true | false",
-       [](RunnerConfig& c, const std::string& v) { c.ekf_first_estimates = parse_auto_switch(v); }},
-      {"ekf", "observability_constraints", "auto",
-       "auto (on where the state space names the world's rigid motions: the globe) | true | false: OC-EKF "
-       "(docs/derivations/observability_constraints.md)",
-       [](RunnerConfig& c, const std::string& v) { c.ekf_observability_constraints = parse_auto_switch(v); }},
-      {"ekf", "gate_probability", "0", "Mahalanobis gate: reject observations above this chi-square quantile; 0 = off",
-       [](RunnerConfig& c, const std::string& v) { c.ekf.gate_probability = parse_gate_probability(v); }},
-      {"ekf", "reacquire_after_landmarks", "0",
-       "with the gate on: rejected sightings of this many distinct landmarks, none accepted since, start the test "
-       "of a lost pose (one offset explains them, dead reckoning could have drifted that far, the moved filter "
-       "explains what follows: core/pose_reacquisition.hpp); 0 = keep rejecting",
-       [](RunnerConfig& c, const std::string& v) { c.ekf.reacquisition.min_landmarks = parse_integer<int>(v, 0, 1e6); }},
-      {"ekf", "reacquire_drift_factor", "5",
-       "how many of its own standard deviations real odometry may drift beyond the motion model's dead reckoning",
-       [](RunnerConfig& c, const std::string& v) { c.ekf.reacquisition.drift_factor = positive(parse_number(v), v); }},
-      {"ekf", "reacquire_probation", "20", "sightings the moved copy and the filter are compared over",
-       [](RunnerConfig& c, const std::string& v) { c.ekf.reacquisition.probation = parse_integer<int>(v, 1, 1e6); }},
-      {"ekf", "tangent_reset", "false",
-       "re-read P in the tangent at the corrected pose (G P G^T; SE(3) and world-frame SE(2) only): the error-state "
-       "filter's reset, off because it fights first-estimate Jacobians (docs/derivations/state_space_jacobians.md)",
-       [](RunnerConfig& c, const std::string& v) { c.ekf.tangent_reset = parse_bool(v); }},
-      {"seif", "first_estimate_jacobians", "auto",
-       "auto (on where the pose is perturbed in the world frame: MRCLAM) | true | false",
-       [](RunnerConfig& c, const std::string& v) { c.seif_first_estimates = parse_auto_switch(v); }},
-      {"seif", "observability_constraints", "auto",
-       "auto (on where the state space names the world's rigid motions: the globe) | true | false",
-       [](RunnerConfig& c, const std::string& v) { c.seif_observability_constraints = parse_auto_switch(v); }},
-      {"seif", "gate_probability", "0",
-       "Mahalanobis gate with the exact marginals (one factorization per update); 0 = off",
-       [](RunnerConfig& c, const std::string& v) { c.seif.gate_probability = parse_gate_probability(v); }},
-      {"seif", "max_active", "8", "landmarks kept linked to the robot by sparsification; 0 = no sparsification",
-       [](RunnerConfig& c, const std::string& v) { c.seif.max_active = parse_integer<std::size_t>(v, 0, 1e6); }},
-      {"seif", "sparsification", "thesis",
-       "thesis (eqs. 37-44: drops the links, overconfident) | relocalization (ESEIF: marginalizes the robot and "
-       "relocalizes it from held-back measurements, conservative; needs measurements that determine the robot "
-       "state but for a tail the motion model declares unseen, such as the globe camera's velocities, which are "
-       "relocalized with the prior's covariance; docs/results/seif_relocalization.md)",
-       [](RunnerConfig& c, const std::string& v) {
-         c.seif.sparsification = parse_choice<SeifSparsification>(
-             v, {{"thesis", SeifSparsification::thesis}, {"relocalization", SeifSparsification::relocalization}});
-       }},
-      {"seif", "estimate", "auto",
-       "auto (exact_mean with relocalization, recovered_mean with the thesis's sparsification) | recovered_mean (the "
-       "update's, passive landmarks as they left the active set) | exact_mean (Omega^-1 xi, one more solve per query)",
-       [](RunnerConfig& c, const std::string& v) {
-         c.seif_estimate = v == "auto" ? std::nullopt
-                                       : std::optional(parse_choice<SeifEstimate>(
-                                             v, {{"recovered_mean", SeifEstimate::recovered_mean},
-                                                 {"exact_mean", SeifEstimate::exact_mean}}));
-       }},
-      {"seif", "relocalization_min_information", "0.05",
-       "relocalization: share of the robot's information the held-back measurements must carry in every direction",
-       [](RunnerConfig& c, const std::string& v) { c.seif.relocalization_min_information = non_negative(parse_number(v), v); }},
-      {"seif", "mean_recovery", "active_block", "active_block (joint solve) | coordinate_descent (thesis)",
-       [](RunnerConfig& c, const std::string& v) {
-         c.seif.mean_recovery = parse_choice<MeanRecovery>(
-             v, {{"active_block", MeanRecovery::active_block}, {"coordinate_descent", MeanRecovery::coordinate_descent}});
-       }},
-      {"seif", "mean_recovery_sweeps", "1", "recovery sweeps per update",
-       [](RunnerConfig& c, const std::string& v) { c.seif.mean_recovery_sweeps = parse_integer<int>(v, 0, 1e4); }},
-      {"seif", "exact_recovery_period", "0", "every K updates an exact solve of the whole mean; 0 = never",
-       [](RunnerConfig& c, const std::string& v) { c.seif.exact_recovery_period = parse_integer<int>(v, 0); }},
-      {"graph", "robust_kernel", "none", "none | huber | cauchy, on measurement factors",
-       [](RunnerConfig& c, const std::string& v) {
-         c.graph.measurement_loss.kernel = parse_choice<RobustKernel>(
-             v, {{"none", RobustKernel::none}, {"huber", RobustKernel::huber}, {"cauchy", RobustKernel::cauchy}});
-       }},
-      {"graph", "kernel_width", "2.4477", "robust kernel width, standard deviations of the whitened residual",
-       [](RunnerConfig& c, const std::string& v) { c.graph.measurement_loss.width = positive(parse_number(v), v); }},
-      {"graph", "max_iterations", "10", "Gauss-Newton iterations at most",
-       [](RunnerConfig& c, const std::string& v) { c.graph.max_iterations = parse_integer<int>(v, 1, 1e6); }},
-      {"graph", "solver", "automatic", "automatic | landmark_schur (thesis) | full (sparse Cholesky of everything)",
-       [](RunnerConfig& c, const std::string& v) {
-         c.graph.solver = parse_choice<GraphSolver>(v, {{"automatic", GraphSolver::automatic},
-                                           {"landmark_schur", GraphSolver::landmark_schur},
-                                           {"full", GraphSolver::full}});
-       }},
-      {"graph", "levenberg_marquardt", "false", "damp the Gauss-Newton steps",
-       [](RunnerConfig& c, const std::string& v) { c.graph.levenberg_marquardt = parse_bool(v); }},
-      {"graph", "window", "0", "windowed initialization: optimize growing parts of this many steps first; 0 = off",
-       [](RunnerConfig& c, const std::string& v) { c.graph.window = parse_integer<std::size_t>(v, 0); }},
-      {"graph", "relinearize_threshold", "0.1",
-       "online mode: relinearize a variable when its step exceeds this share of its standard deviation",
-       [](RunnerConfig& c, const std::string& v) { c.graph.relinearize_threshold = positive(parse_number(v), v); }},
-      {"pose_graph", "start", "file", "file (its vertices) | spanning_tree (of the odometry) | chordal (relaxation)",
-       [](RunnerConfig& c, const std::string& v) {
-         c.pose_graph_start = parse_choice<PoseGraphStart>(
-             v, {{"file", PoseGraphStart::file}, {"spanning_tree", PoseGraphStart::spanning_tree}, {"chordal", PoseGraphStart::chordal}});
-       }},
-      {"pose_graph", "loop_closure_kernel", "none", "none | huber | cauchy, on edges between non-consecutive poses",
-       [](RunnerConfig& c, const std::string& v) {
-         c.pose_graph.loop_closure_loss.kernel = parse_choice<RobustKernel>(
-             v, {{"none", RobustKernel::none}, {"huber", RobustKernel::huber}, {"cauchy", RobustKernel::cauchy}});
-       }},
-      {"pose_graph", "odometry_kernel", "none", "none | huber | cauchy, on edges between consecutive poses",
-       [](RunnerConfig& c, const std::string& v) {
-         c.pose_graph.odometry_loss.kernel = parse_choice<RobustKernel>(
-             v, {{"none", RobustKernel::none}, {"huber", RobustKernel::huber}, {"cauchy", RobustKernel::cauchy}});
-       }},
-      {"pose_graph", "kernel_width", "2.4477", "robust kernel width, standard deviations of the whitened residual",
-       [](RunnerConfig& c, const std::string& v) {
-         c.pose_graph.loop_closure_loss.width = c.pose_graph.odometry_loss.width = positive(parse_number(v), v);
-       }},
-      {"pose_graph", "outlier_gate_probability", "0",
-       "after the robust optimization, edges with a kernel beyond this chi-square quantile are dropped and the rest "
-       "solved again by least squares; 0 = off (docs/results/pose_graphs.md: cauchy, width 1, 0.999)",
-       [](RunnerConfig& c, const std::string& v) { c.pose_graph.outlier_gate_probability = parse_gate_probability(v); }},
-      {"pose_graph", "max_iterations", "100", "Levenberg-Marquardt iterations at most",
-       [](RunnerConfig& c, const std::string& v) { c.pose_graph.max_iterations = parse_integer<int>(v, 0, 1e6); }},
-      {"fastslam", "gate_probability", "0", "per-particle Mahalanobis gate on known landmarks; 0 = off",
-       [](RunnerConfig& c, const std::string& v) { c.fastslam.gate_probability = parse_gate_probability(v); }},
-      {"fastslam", "particles", "100", "particles",
-       [](RunnerConfig& c, const std::string& v) { c.fastslam.particles = parse_integer<std::size_t>(v, 1, 1e6); }},
-      {"fastslam", "resample_threshold", "0.1", "resample when N_eff < threshold * particles (1 = always, 0 = never)",
-       [](RunnerConfig& c, const std::string& v) {
-         const double t = parse_number(v);
-         if (t < 0.0 || t > 1.0) throw invalid_input_error("'" + v + "' must be in [0, 1]");
-         c.fastslam.resample_threshold = t;
-       }},
-      {"fastslam", "map_estimate", "weighted_average", "best_particle | weighted_average (moment-matched over particles)",
-       [](RunnerConfig& c, const std::string& v) {
-         c.fastslam.map_estimate =
-             parse_choice<FastSlamMap>(v, {{"best_particle", FastSlamMap::best_particle}, {"weighted_average", FastSlamMap::weighted_average}});
-       }},
-      {"fastslam", "linear_tail", "sampled",
-       "sampled | kalman: what particles do with state entries the motion model declares conditionally linear "
-       "(the globe camera's velocity and rate): sample them, or keep a Kalman filter over them per particle",
-       [](RunnerConfig& c, const std::string& v) {
-         c.fastslam.linear_tail = parse_choice<FastSlamLinearTail>(
-             v, {{"sampled", FastSlamLinearTail::sampled}, {"kalman", FastSlamLinearTail::kalman}});
-       }},
-      {"fastslam", "seed", "1", "random seed",
-       [](RunnerConfig& c, const std::string& v) { c.fastslam.seed = parse_integer<std::uint64_t>(v, 0); }},
-      {"scene", "quantile", "3", "size of the covariance ellipses in the .3Dscene, standard deviations",
-       [](RunnerConfig& c, const std::string& v) { c.scene_quantile = positive(parse_number(v), v); }},
+  return {
+    {"ship", "seed", "1", "first simulation seed of the 2D beacon-ship Monte Carlo runs",
+     [](RunnerConfig& c, const std::string& v) { c.ship.seed = parse_integer<std::uint64_t>(v, 0); }},
+    {"ship", "runs", "10", "Monte Carlo runs (seeds seed .. seed+runs-1); the table averages them",
+     [](RunnerConfig& c, const std::string& v) { c.ship_runs = parse_integer<int>(v, 1, 1e5); }},
+    {"ship", "steps", "1390", "steps per run (thesis: 1390)",
+     [](RunnerConfig& c, const std::string& v) { c.ship.num_steps = parse_integer<int>(v, 1, 1e7); }},
+    {"ship", "sigma_heading_deg", "15", "compass noise, degrees (thesis: 15)",
+     [](RunnerConfig& c, const std::string& v) { c.ship.sigma_heading = positive(parse_number(v), v) * deg; }},
+    {"ship", "sigma_beacon", "2", "beacon offset noise per axis, km",
+     [](RunnerConfig& c, const std::string& v) { c.ship.sigma_beacon = positive(parse_number(v), v); }},
   };
+}
+
+/// [globe]: the globe (12D camera) simulation, its pool and its filter runs.
+inline std::vector<ConfigKey> globe_keys() {
+  return {
+    {"globe", "seed", "1", "simulation seed of the globe (12D camera) experiment",
+     [](RunnerConfig& c, const std::string& v) { c.globe.seed = parse_integer<std::uint64_t>(v, 0); }},
+    {"globe", "steps", "500", "steps (thesis: 500); the circle closes near step 420",
+     [](RunnerConfig& c, const std::string& v) { c.globe.steps = parse_integer<int>(v, 1, 1e6); }},
+    {"globe", "points", "3000", "feature points on the globe",
+     [](RunnerConfig& c, const std::string& v) { c.globe.points = parse_integer<int>(v, 1, 1e7); }},
+    {"globe", "features_per_frame", "120", "strongest visible points observed per frame",
+     [](RunnerConfig& c, const std::string& v) { c.globe.features_per_frame = parse_integer<int>(v, 1, 1e5); }},
+    {"globe", "response_jitter", "0",
+     "log-normal frame-to-frame noise of the detector's responses (0 = the same strongest points every frame; "
+     "1 with 20000 points and Mmax 10000: the thesis-scale run of docs/results/real_time.md)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.response_jitter = non_negative(parse_number(v), v); }},
+    {"globe", "max_landmarks", "1000", "landmark pool capacity Mmax (thesis: 1000)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_landmarks = parse_integer<std::size_t>(v, 1, 1e6); }},
+    {"globe", "max_new_per_step", "50", "new landmarks per step at most (thesis: 50)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_new_per_step = parse_integer<std::size_t>(v, 1, 1e6); }},
+    {"globe", "seif_active", "150 250 0", "SEIF runs, one per value: active landmarks (0 = all)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.seif_active = parse_active_counts(v, false); }},
+    {"globe", "eseif_active", "150 250",
+     "ESEIF runs (back-end eseif: SEIF with relocalization, consistent; docs/results/seif_relocalization.md), one "
+     "per value: active landmarks (at least 1); 'none' = no such run",
+     [](RunnerConfig& c, const std::string& v) { c.globe.eseif_active = parse_active_counts(v, true); }},
+    {"globe", "covariance_period", "10", "NEES of the pose every this many steps (a SEIF's covariance costs a factorization)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.covariance_period = parse_integer<std::size_t>(v, 1); }},
+  };
+}
+
+/// [globe]: the stereo front-end (globe-stereo, stereo:DIR) and its tracker.
+inline std::vector<ConfigKey> globe_stereo_keys() {
+  return {
+    {"globe", "tracker", "ekf",
+     "globe-stereo, stereo:DIR: the back-end that tracks the images and gates the association: ekf, seif (its "
+     "first seif_active value, [seif]'s sparsification) or eseif (relocalizing, its first eseif_active value)",
+     [](RunnerConfig& c, const std::string& v) {
+       one_of(v, {"ekf", "seif", "eseif"}, "tracker");
+       c.globe.tracker = v == "ekf" ? BackendKind::ekf : v == "seif" ? BackendKind::seif : BackendKind::eseif;
+     }},
+    {"globe", "tracker_gate", "conditional",
+     "a SEIF tracker's gate: conditional (the robot and each landmark given the rest of the map, O(1) per "
+     "landmark) | joint_marginal (exact: one solve with the factor of Omega a frame)",
+     [](RunnerConfig& c, const std::string& v) {
+       c.globe.tracker_exact_gate = one_of(v, {"conditional", "joint_marginal"}, "tracker gate") == "joint_marginal";
+     }},
+    {"globe", "octave_layers", "4",
+     "globe-stereo, stereo:DIR: AKAZE's sublevels per octave (OpenCV's default 4; its time is mostly building them)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.octave_layers = parse_integer<int>(v, 1, 16); }},
+    {"globe", "detector_threshold", "0.001", "globe-stereo, stereo:DIR: AKAZE's response threshold (OpenCV's default)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.detector_threshold = positive(parse_number(v), v); }},
+    {"globe", "stereo_correspondence", "detect_both",
+     "globe-stereo, stereo:DIR: detect_both (AKAZE in both images, matched along the rows by descriptor) | "
+     "row_search (AKAZE in the left image only, each keypoint found along its row in the right by correlation)",
+     [](RunnerConfig& c, const std::string& v) {
+       c.globe.row_search = one_of(v, {"detect_both", "row_search"}, "stereo correspondence") == "row_search";
+     }},
+    {"globe", "pipelined", "true",
+     "globe-stereo, stereo:DIR: true (frame k+1's features found on a second thread while frame k is associated "
+     "and filtered, as a live camera allows; the same results) | false (one frame after another)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.pipelined = parse_bool(v); }},
+    {"globe", "opencv_threads", "1",
+     "globe-stereo, stereo:DIR: OpenCV's worker threads inside AKAZE (0 = OpenCV's default, one per core); the "
+     "pipeline and the two images on two threads keep the cores busy already",
+     [](RunnerConfig& c, const std::string& v) { c.globe.opencv_threads = parse_integer<int>(v, 0, 256); }},
+  };
+}
+
+/// [globe]: the globe's GraphSLAM runs.
+inline std::vector<ConfigKey> globe_graph_keys() {
+  return {
+    {"globe", "graph_updates", "10", "GraphSLAM global updates after the windowed initialization (thesis Table 10: 10)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.graph_updates = parse_integer<int>(v, 1, 1e4); }},
+    {"globe", "graph", "batch",
+     "batch (the thesis's: record, then global updates) | online (one incremental Gauss-Newton step a frame, "
+     "[graph] relinearize_threshold) | both (a row each)",
+     [](RunnerConfig& c, const std::string& v) {
+       one_of(v, {"batch", "online", "both"}, "GraphSLAM mode");
+       c.globe.graph_batch = v != "online";
+       c.globe.graph_online = v != "batch";
+     }},
+  };
+}
+
+/// [vislam]: the visual-inertial runs.
+inline std::vector<ConfigKey> vislam_keys() {
+  return {
+    {"vislam", "velocity_sigma", "0.5", "m/s: IMU linear velocity noise per axis (.npz data)",
+     [](RunnerConfig& c, const std::string& v) { c.vislam.velocity_sigma = positive(parse_number(v), v); }},
+    {"vislam", "rate_sigma", "0.05", "rad/s: IMU angular velocity noise per axis (.npz data)",
+     [](RunnerConfig& c, const std::string& v) { c.vislam.rate_sigma = positive(parse_number(v), v); }},
+    {"vislam", "pixel_sigma", "2", "px: stereo feature noise (.npz data)",
+     [](RunnerConfig& c, const std::string& v) { c.vislam.pixel_sigma = positive(parse_number(v), v); }},
+    {"vislam", "min_disparity", "2", "px: smallest disparity a new landmark is triangulated from (.npz data)",
+     [](RunnerConfig& c, const std::string& v) { c.vislam.min_disparity = non_negative(parse_number(v), v); }},
+    {"vislam", "max_landmarks", "150", "landmark pool capacity (EKF: <= 10 ms per frame on 03.npz)",
+     [](RunnerConfig& c, const std::string& v) { c.vislam.pool.max_landmarks = parse_integer<std::size_t>(v, 1, 1e6); }},
+    {"vislam", "max_new_per_step", "20", "new landmarks per frame at most",
+     [](RunnerConfig& c, const std::string& v) { c.vislam.pool.max_new_per_step = parse_integer<std::size_t>(v, 1, 1e6); }},
+    {"vislam", "gate_probability", "0.999", "Mahalanobis gate of the filters (0 = off)",
+     [](RunnerConfig& c, const std::string& v) { c.vislam.gate_probability = parse_gate_probability(v); }},
+    {"vislam", "seed", "1", "simulation seed of stereo-vi",
+     [](RunnerConfig& c, const std::string& v) { c.vislam.seed = parse_integer<std::uint64_t>(v, 0); }},
+    {"vislam", "steps", "400", "stereo-vi frames (one loop)",
+     [](RunnerConfig& c, const std::string& v) { c.vislam.steps = parse_integer<int>(v, 1, 1e6); }},
+  };
+}
+
+/// [rawlog]: MRPT rawlogs and the sensor noise used with them.
+inline std::vector<ConfigKey> rawlog_keys() {
+  constexpr double deg = std::numbers::pi / 180.0;
+  return {
+    {"rawlog", "std_range", "0", "range noise, m; 0 = as stated in the rawlog",
+     [](RunnerConfig& c, const std::string& v) {
+       const double x = non_negative(parse_number(v), v);
+       c.rawlog.std_range = x > 0.0 ? std::optional<double>(x) : std::nullopt;
+     }},
+    {"rawlog", "std_yaw_deg", "0", "bearing (yaw) noise, degrees; 0 = as stated in the rawlog",
+     [](RunnerConfig& c, const std::string& v) {
+       const double x = non_negative(parse_number(v), v);
+       c.rawlog.std_yaw = x > 0.0 ? std::optional<double>(x * deg) : std::nullopt;
+     }},
+    {"rawlog", "std_pitch_deg", "0", "pitch noise (3D), degrees; 0 = as stated in the rawlog",
+     [](RunnerConfig& c, const std::string& v) {
+       const double x = non_negative(parse_number(v), v);
+       c.rawlog.std_pitch = x > 0.0 ? std::optional<double>(x * deg) : std::nullopt;
+     }},
+    {"rawlog", "odometry_std_xy", "0.1", "observation-only rawlogs: odometry noise per step along x and y, m",
+     [](RunnerConfig& c, const std::string& v) {
+       c.rawlog.odometry_std(0) = c.rawlog.odometry_std(1) = positive(parse_number(v), v);
+     }},
+    {"rawlog", "odometry_std_phi_deg", "4", "observation-only rawlogs: odometry heading noise per step, degrees",
+     [](RunnerConfig& c, const std::string& v) { c.rawlog.odometry_std(2) = positive(parse_number(v), v) * deg; }},
+    {"rawlog", "prior_std", "1e-06", "standard deviation of the start pose (the robot starts at the map origin)",
+     [](RunnerConfig& c, const std::string& v) { c.rawlog.prior_std = positive(parse_number(v), v); }},
+    {"rawlog", "max_steps", "0", "read at most this many steps; 0 = all",
+     [](RunnerConfig& c, const std::string& v) { c.rawlog.max_steps = parse_integer<std::size_t>(v, 0); }},
+  };
+}
+
+/// [mrclam]: the UTIAS MRCLAM robots.
+inline std::vector<ConfigKey> mrclam_keys() {
+  constexpr double deg = std::numbers::pi / 180.0;
+  return {
+    {"mrclam", "max_step", "0.25", "MRCLAM: longest step without a measurement, s (steps also end at every measurement)",
+     [](RunnerConfig& c, const std::string& v) { c.mrclam.max_step = positive(parse_number(v), v); }},
+    {"mrclam", "odometry_delay", "0.2", "MRCLAM: seconds added to the odometry time stamps (Dataset6: 0.2 matches Vicon best)",
+     [](RunnerConfig& c, const std::string& v) {
+       const double d = parse_number(v);
+       if (!(std::abs(d) <= 10.0)) throw invalid_input_error("'" + v + "' must be in [-10, 10] s");
+       c.mrclam.odometry_delay = d;
+     }},
+    {"mrclam", "std_range", "0.15", "MRCLAM: range noise, m (robust SD against Vicon: 0.13)",
+     [](RunnerConfig& c, const std::string& v) { c.mrclam.measurement_sigma(0) = positive(parse_number(v), v); }},
+    {"mrclam", "std_bearing_deg", "1.146", "MRCLAM: bearing noise, degrees (robust SD against Vicon: 0.49)",
+     [](RunnerConfig& c, const std::string& v) { c.mrclam.measurement_sigma(1) = positive(parse_number(v), v) * deg; }},
+    {"mrclam", "alpha", "0.015 0.002 0.02 0.1 0 0.001",
+     "MRCLAM: velocity motion model noise a1..a6 (Thrun): var v = a1 v^2 + a2 w^2, var w = a3 v^2 + a4 w^2, final "
+     "turn a5 v^2 + a6 w^2",
+     [](RunnerConfig& c, const std::string& v) {
+       std::istringstream in(v);
+       std::vector<double> values;
+       for (std::string word; in >> word;) values.push_back(parse_number(word));
+       if (values.size() != 6 || std::any_of(values.begin(), values.end(), [](double a) { return a < 0.0; }))
+         throw invalid_input_error("'" + v + "' must be six non-negative numbers");
+       std::copy(values.begin(), values.end(), c.mrclam.motion.alpha.begin());
+     }},
+    {"mrclam", "gate_probability", "0.9999",
+     "MRCLAM: Mahalanobis gate of EKF, SEIF and FastSLAM (real data has outliers; 0 = off); overrides their own",
+     [](RunnerConfig& c, const std::string& v) { c.mrclam_gate_probability = parse_gate_probability(v); }},
+    {"mrclam", "reacquire_after_landmarks", "3",
+     "MRCLAM: the EKF re-acquires a pose lost beyond its covariance (with the gate on; 0 = never); overrides [ekf]",
+     [](RunnerConfig& c, const std::string& v) { c.mrclam_reacquire_after_landmarks = parse_integer<int>(v, 0, 1e6); }},
+    {"mrclam", "graph_robust_kernel", "cauchy", "MRCLAM: GraphSLAM's robust kernel (none | huber | cauchy); overrides [graph]",
+     [](RunnerConfig& c, const std::string& v) {
+       c.mrclam_graph_kernel = parse_choice<RobustKernel>(
+           v, {{"none", RobustKernel::none}, {"huber", RobustKernel::huber}, {"cauchy", RobustKernel::cauchy}});
+     }},
+    {"mrclam", "filters_in_world_frame", "true",
+     "MRCLAM: EKF and SEIF perturb the pose in the world frame (with the EKF's first-estimate Jacobians: no "
+     "spurious heading information); GraphSLAM and FastSLAM keep the additive chart",
+     [](RunnerConfig& c, const std::string& v) { c.mrclam_filters_in_world_frame = parse_bool(v); }},
+  };
+}
+
+/// [association]: data association without known ids.
+inline std::vector<ConfigKey> association_keys() {
+  return {
+    {"association", "method", "known",
+     "known (the data set's ids) | nn (nearest neighbour) | jcbb (joint compatibility): ids withheld and found by "
+     "EKF and SEIF; FastSLAM associates per particle; GraphSLAM needs known ids",
+     [](RunnerConfig& c, const std::string& v) {
+       c.association.method = parse_choice<std::optional<AssociationMethod>>(
+           v, {{"known", std::nullopt},
+               {"nn", AssociationMethod::nearest_neighbour},
+               {"jcbb", AssociationMethod::joint_compatibility}});
+     }},
+    {"association", "gate_probability", "0.99", "chi-square gate of individual and joint compatibility",
+     [](RunnerConfig& c, const std::string& v) { c.association.options.gate_probability = parse_probability(v); }},
+    {"association", "new_landmark_probability", "0.9999",
+     "a measurement outside every landmark's gate at this probability starts a new landmark; inside one but unpaired "
+     "it is discarded",
+     [](RunnerConfig& c, const std::string& v) { c.association.options.new_landmark_probability = parse_probability(v); }},
+  };
+}
+
+/// [ekf]: EKF-SLAM's options.
+inline std::vector<ConfigKey> ekf_keys() {
+  return {
+    {"ekf", "batch_update", "true", "one joint correction per step (true) or one per observation (false)",
+     [](RunnerConfig& c, const std::string& v) { c.ekf.batch_update = parse_bool(v); }},
+    {"ekf", "covariance_update", "symmetric", "symmetric (lower-triangle rank update) | joseph",
+     [](RunnerConfig& c, const std::string& v) {
+       c.ekf.covariance_update =
+           parse_choice<CovarianceUpdate>(v, {{"symmetric", CovarianceUpdate::symmetric}, {"joseph", CovarianceUpdate::joseph}});
+     }},
+    {"ekf", "first_estimate_jacobians", "auto",
+     "auto (on where the pose is perturbed in the world frame: MRCLAM) | true | false",
+     [](RunnerConfig& c, const std::string& v) { c.ekf_first_estimates = parse_auto_switch(v); }},
+    {"ekf", "observability_constraints", "auto",
+     "auto (on where the state space names the world's rigid motions: the globe) | true | false: OC-EKF "
+     "(docs/derivations/observability_constraints.md)",
+     [](RunnerConfig& c, const std::string& v) { c.ekf_observability_constraints = parse_auto_switch(v); }},
+    {"ekf", "gate_probability", "0", "Mahalanobis gate: reject observations above this chi-square quantile; 0 = off",
+     [](RunnerConfig& c, const std::string& v) { c.ekf.gate_probability = parse_gate_probability(v); }},
+    {"ekf", "reacquire_after_landmarks", "0",
+     "with the gate on: rejected sightings of this many distinct landmarks, none accepted since, start the test "
+     "of a lost pose (one offset explains them, dead reckoning could have drifted that far, the moved filter "
+     "explains what follows: core/pose_reacquisition.hpp); 0 = keep rejecting",
+     [](RunnerConfig& c, const std::string& v) { c.ekf.reacquisition.min_landmarks = parse_integer<int>(v, 0, 1e6); }},
+    {"ekf", "reacquire_drift_factor", "5",
+     "how many of its own standard deviations real odometry may drift beyond the motion model's dead reckoning",
+     [](RunnerConfig& c, const std::string& v) { c.ekf.reacquisition.drift_factor = positive(parse_number(v), v); }},
+    {"ekf", "reacquire_probation", "20", "sightings the moved copy and the filter are compared over",
+     [](RunnerConfig& c, const std::string& v) { c.ekf.reacquisition.probation = parse_integer<int>(v, 1, 1e6); }},
+    {"ekf", "tangent_reset", "false",
+     "re-read P in the tangent at the corrected pose (G P G^T; SE(3) and world-frame SE(2) only): the error-state "
+     "filter's reset, off because it fights first-estimate Jacobians (docs/derivations/state_space_jacobians.md)",
+     [](RunnerConfig& c, const std::string& v) { c.ekf.tangent_reset = parse_bool(v); }},
+  };
+}
+
+/// [seif]: SEIF-SLAM's options.
+inline std::vector<ConfigKey> seif_keys() {
+  return {
+    {"seif", "first_estimate_jacobians", "auto",
+     "auto (on where the pose is perturbed in the world frame: MRCLAM) | true | false",
+     [](RunnerConfig& c, const std::string& v) { c.seif_first_estimates = parse_auto_switch(v); }},
+    {"seif", "observability_constraints", "auto",
+     "auto (on where the state space names the world's rigid motions: the globe) | true | false",
+     [](RunnerConfig& c, const std::string& v) { c.seif_observability_constraints = parse_auto_switch(v); }},
+    {"seif", "gate_probability", "0",
+     "Mahalanobis gate with the exact marginals (one factorization per update); 0 = off",
+     [](RunnerConfig& c, const std::string& v) { c.seif.gate_probability = parse_gate_probability(v); }},
+    {"seif", "max_active", "8", "landmarks kept linked to the robot by sparsification; 0 = no sparsification",
+     [](RunnerConfig& c, const std::string& v) { c.seif.max_active = parse_integer<std::size_t>(v, 0, 1e6); }},
+    {"seif", "sparsification", "thesis",
+     "thesis (eqs. 37-44: drops the links, overconfident) | relocalization (ESEIF: marginalizes the robot and "
+     "relocalizes it from held-back measurements, conservative; needs measurements that determine the robot "
+     "state but for a tail the motion model declares unseen, such as the globe camera's velocities, which are "
+     "relocalized with the prior's covariance; docs/results/seif_relocalization.md)",
+     [](RunnerConfig& c, const std::string& v) {
+       c.seif.sparsification = parse_choice<SeifSparsification>(
+           v, {{"thesis", SeifSparsification::thesis}, {"relocalization", SeifSparsification::relocalization}});
+     }},
+    {"seif", "estimate", "auto",
+     "auto (exact_mean with relocalization, recovered_mean with the thesis's sparsification) | recovered_mean (the "
+     "update's, passive landmarks as they left the active set) | exact_mean (Omega^-1 xi, one more solve per query)",
+     [](RunnerConfig& c, const std::string& v) {
+       c.seif_estimate = v == "auto" ? std::nullopt
+                                     : std::optional(parse_choice<SeifEstimate>(
+                                           v, {{"recovered_mean", SeifEstimate::recovered_mean},
+                                               {"exact_mean", SeifEstimate::exact_mean}}));
+     }},
+    {"seif", "relocalization_min_information", "0.05",
+     "relocalization: share of the robot's information the held-back measurements must carry in every direction",
+     [](RunnerConfig& c, const std::string& v) { c.seif.relocalization_min_information = non_negative(parse_number(v), v); }},
+    {"seif", "mean_recovery", "active_block", "active_block (joint solve) | coordinate_descent (thesis)",
+     [](RunnerConfig& c, const std::string& v) {
+       c.seif.mean_recovery = parse_choice<MeanRecovery>(
+           v, {{"active_block", MeanRecovery::active_block}, {"coordinate_descent", MeanRecovery::coordinate_descent}});
+     }},
+    {"seif", "mean_recovery_sweeps", "1", "recovery sweeps per update",
+     [](RunnerConfig& c, const std::string& v) { c.seif.mean_recovery_sweeps = parse_integer<int>(v, 0, 1e4); }},
+    {"seif", "exact_recovery_period", "0", "every K updates an exact solve of the whole mean; 0 = never",
+     [](RunnerConfig& c, const std::string& v) { c.seif.exact_recovery_period = parse_integer<int>(v, 0); }},
+  };
+}
+
+/// [graph]: GraphSLAM's options.
+inline std::vector<ConfigKey> graph_keys() {
+  return {
+    {"graph", "robust_kernel", "none", "none | huber | cauchy, on measurement factors",
+     [](RunnerConfig& c, const std::string& v) {
+       c.graph.measurement_loss.kernel = parse_choice<RobustKernel>(
+           v, {{"none", RobustKernel::none}, {"huber", RobustKernel::huber}, {"cauchy", RobustKernel::cauchy}});
+     }},
+    {"graph", "kernel_width", "2.4477", "robust kernel width, standard deviations of the whitened residual",
+     [](RunnerConfig& c, const std::string& v) { c.graph.measurement_loss.width = positive(parse_number(v), v); }},
+    {"graph", "max_iterations", "10", "Gauss-Newton iterations at most",
+     [](RunnerConfig& c, const std::string& v) { c.graph.max_iterations = parse_integer<int>(v, 1, 1e6); }},
+    {"graph", "solver", "automatic", "automatic | landmark_schur (thesis) | full (sparse Cholesky of everything)",
+     [](RunnerConfig& c, const std::string& v) {
+       c.graph.solver = parse_choice<GraphSolver>(v, {{"automatic", GraphSolver::automatic},
+                                         {"landmark_schur", GraphSolver::landmark_schur},
+                                         {"full", GraphSolver::full}});
+     }},
+    {"graph", "levenberg_marquardt", "false", "damp the Gauss-Newton steps",
+     [](RunnerConfig& c, const std::string& v) { c.graph.levenberg_marquardt = parse_bool(v); }},
+    {"graph", "window", "0", "windowed initialization: optimize growing parts of this many steps first; 0 = off",
+     [](RunnerConfig& c, const std::string& v) { c.graph.window = parse_integer<std::size_t>(v, 0); }},
+    {"graph", "relinearize_threshold", "0.1",
+     "online mode: relinearize a variable when its step exceeds this share of its standard deviation",
+     [](RunnerConfig& c, const std::string& v) { c.graph.relinearize_threshold = positive(parse_number(v), v); }},
+  };
+}
+
+/// [pose_graph]: the pose-graph runs.
+inline std::vector<ConfigKey> pose_graph_keys() {
+  return {
+    {"pose_graph", "start", "file", "file (its vertices) | spanning_tree (of the odometry) | chordal (relaxation)",
+     [](RunnerConfig& c, const std::string& v) {
+       c.pose_graph_start = parse_choice<PoseGraphStart>(
+           v, {{"file", PoseGraphStart::file}, {"spanning_tree", PoseGraphStart::spanning_tree}, {"chordal", PoseGraphStart::chordal}});
+     }},
+    {"pose_graph", "loop_closure_kernel", "none", "none | huber | cauchy, on edges between non-consecutive poses",
+     [](RunnerConfig& c, const std::string& v) {
+       c.pose_graph.loop_closure_loss.kernel = parse_choice<RobustKernel>(
+           v, {{"none", RobustKernel::none}, {"huber", RobustKernel::huber}, {"cauchy", RobustKernel::cauchy}});
+     }},
+    {"pose_graph", "odometry_kernel", "none", "none | huber | cauchy, on edges between consecutive poses",
+     [](RunnerConfig& c, const std::string& v) {
+       c.pose_graph.odometry_loss.kernel = parse_choice<RobustKernel>(
+           v, {{"none", RobustKernel::none}, {"huber", RobustKernel::huber}, {"cauchy", RobustKernel::cauchy}});
+     }},
+    {"pose_graph", "kernel_width", "2.4477", "robust kernel width, standard deviations of the whitened residual",
+     [](RunnerConfig& c, const std::string& v) {
+       c.pose_graph.loop_closure_loss.width = c.pose_graph.odometry_loss.width = positive(parse_number(v), v);
+     }},
+    {"pose_graph", "outlier_gate_probability", "0",
+     "after the robust optimization, edges with a kernel beyond this chi-square quantile are dropped and the rest "
+     "solved again by least squares; 0 = off (docs/results/pose_graphs.md: cauchy, width 1, 0.999)",
+     [](RunnerConfig& c, const std::string& v) { c.pose_graph.outlier_gate_probability = parse_gate_probability(v); }},
+    {"pose_graph", "max_iterations", "100", "Levenberg-Marquardt iterations at most",
+     [](RunnerConfig& c, const std::string& v) { c.pose_graph.max_iterations = parse_integer<int>(v, 0, 1e6); }},
+  };
+}
+
+/// [fastslam]: FastSLAM's options.
+inline std::vector<ConfigKey> fastslam_keys() {
+  return {
+    {"fastslam", "gate_probability", "0", "per-particle Mahalanobis gate on known landmarks; 0 = off",
+     [](RunnerConfig& c, const std::string& v) { c.fastslam.gate_probability = parse_gate_probability(v); }},
+    {"fastslam", "particles", "100", "particles",
+     [](RunnerConfig& c, const std::string& v) { c.fastslam.particles = parse_integer<std::size_t>(v, 1, 1e6); }},
+    {"fastslam", "resample_threshold", "0.1", "resample when N_eff < threshold * particles (1 = always, 0 = never)",
+     [](RunnerConfig& c, const std::string& v) {
+       const double t = parse_number(v);
+       if (t < 0.0 || t > 1.0) throw invalid_input_error("'" + v + "' must be in [0, 1]");
+       c.fastslam.resample_threshold = t;
+     }},
+    {"fastslam", "map_estimate", "weighted_average", "best_particle | weighted_average (moment-matched over particles)",
+     [](RunnerConfig& c, const std::string& v) {
+       c.fastslam.map_estimate =
+           parse_choice<FastSlamMap>(v, {{"best_particle", FastSlamMap::best_particle}, {"weighted_average", FastSlamMap::weighted_average}});
+     }},
+    {"fastslam", "linear_tail", "sampled",
+     "sampled | kalman: what particles do with state entries the motion model declares conditionally linear "
+     "(the globe camera's velocity and rate): sample them, or keep a Kalman filter over them per particle",
+     [](RunnerConfig& c, const std::string& v) {
+       c.fastslam.linear_tail = parse_choice<FastSlamLinearTail>(
+           v, {{"sampled", FastSlamLinearTail::sampled}, {"kalman", FastSlamLinearTail::kalman}});
+     }},
+    {"fastslam", "seed", "1", "random seed",
+     [](RunnerConfig& c, const std::string& v) { c.fastslam.seed = parse_integer<std::uint64_t>(v, 0); }},
+  };
+}
+
+/// [scene]: the MRPT 3D scenes.
+inline std::vector<ConfigKey> scene_keys() {
+  return {
+    {"scene", "quantile", "3", "size of the covariance ellipses in the .3Dscene, standard deviations",
+     [](RunnerConfig& c, const std::string& v) { c.scene_quantile = positive(parse_number(v), v); }},
+  };
+}
+
+}  // namespace detail
+
+/// Every key sextant-run understands, in --print-config's order.
+inline const std::vector<ConfigKey>& config_keys() {
+  static const std::vector<ConfigKey> keys = [] {
+    std::vector<ConfigKey> all;
+    for (const auto& section : {detail::ship_keys(), detail::globe_keys(), detail::globe_stereo_keys(),
+                                detail::globe_graph_keys(), detail::vislam_keys(), detail::rawlog_keys(),
+                                detail::mrclam_keys(), detail::association_keys(), detail::ekf_keys(),
+                                detail::seif_keys(), detail::graph_keys(), detail::pose_graph_keys(),
+                                detail::fastslam_keys(), detail::scene_keys()})
+      all.insert(all.end(), section.begin(), section.end());
+    return all;
+  }();
   return keys;
 }
 
