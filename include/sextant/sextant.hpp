@@ -24,6 +24,7 @@
 #include "sextant/core/se3.hpp"
 #include "sextant/core/se3_space.hpp"
 #include "sextant/core/so3.hpp"
+#include "sextant/core/seconds_since.hpp"
 #include "sextant/core/selected_inverse.hpp"
 #include "sextant/core/sparse_cholesky.hpp"
 #include "sextant/core/sparse_information.hpp"

@@ -233,7 +233,7 @@ std::vector<TableRow> run_globe_stereo(const CliOptions& cli, const std::string&
     auto render = [&](std::size_t k) {
       const auto start = std::chrono::steady_clock::now();
       const auto images = sim::render_stereo(o, points.true_poses[k + 1]);
-      totals.render += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      totals.render += seconds_since(start);
       vision::StereoPair pair{vision::as_mat(images.left).clone(), vision::as_mat(images.right).clone()};
       if (!save_images.empty()) vision::write_stereo_pair(save_images, k, pair.left, pair.right);
       if (k == picture_step) picture.left = pair.left, picture.right = pair.right;

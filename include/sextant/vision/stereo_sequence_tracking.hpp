@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 #include <utility>
 
+#include "sextant/core/seconds_since.hpp"
 #include "sextant/vision/stereo_front_end.hpp"
 
 namespace sextant::vision {
@@ -28,14 +29,6 @@ struct SequenceClock {
   double frames_per_second() const { return seconds > 0.0 ? static_cast<double>(frames) / seconds : 0.0; }
 };
 
-namespace detail {
-
-inline double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace detail
-
 /// Tracks frames 0..n-1 with `tracker`: `pair_of(k)` gives frame k's StereoPair, `dt_of(k)` the time
 /// since the previous frame, `on_frame(k, tracked)` receives each TrackedFrame in order. With
 /// `pipelined`, frame k+1's observe runs on its own thread during frame k's incorporate. Either way
@@ -51,7 +44,7 @@ SequenceClock track_sequence(Tracker& tracker, std::size_t n, PairOf&& pair_of, 
       const StereoPair pair = pair_of(k);
       const auto start = Clock::now();
       auto tracked = tracker.track(pair.left, pair.right, {}, dt_of(k));
-      clock.seconds += detail::seconds_since(start);
+      clock.seconds += seconds_since(start);
       on_frame(k, tracked);
     }
     return clock;
@@ -60,7 +53,7 @@ SequenceClock track_sequence(Tracker& tracker, std::size_t n, PairOf&& pair_of, 
   StereoPair pair = pair_of(0);
   auto start = Clock::now();
   StereoFrame frame = tracker.observe(pair.left, pair.right);
-  clock.seconds += detail::seconds_since(start);
+  clock.seconds += seconds_since(start);
   for (std::size_t k = 0; k < n; ++k) {
     const bool has_next = k + 1 < n;
     if (has_next) pair = pair_of(k + 1);
@@ -81,7 +74,7 @@ SequenceClock track_sequence(Tracker& tracker, std::size_t n, PairOf&& pair_of, 
       } catch (...) {
         next_failed = std::current_exception();
       }
-    clock.seconds += detail::seconds_since(start);
+    clock.seconds += seconds_since(start);
     on_frame(k, tracked);
     if (next_failed) std::rethrow_exception(next_failed);
   }

@@ -2,9 +2,9 @@
 /// \file The full image-to-map step of the thesis's vSLAM framework: a filter through the bounded
 /// landmark pool tracks the camera (EKF-SLAM or SEIF-SLAM: any back-end with landmark_means() and
 /// joint_marginal(); SEIF gates with its conditional blocks by default), and its predictions gate
-/// the association of each new stereo frame's features with the map (vision/map_association.hpp). The observations it hands to its back-end, with their
-/// landmark ids, are the front-end's output: other back-ends replay them
-/// (docs/results/globe_stereo.md says why one association serves them all).
+/// the association of each new stereo frame's features with the map (vision/map_association.hpp).
+/// The observations it hands to its back-end, with their landmark ids, are the front-end's output:
+/// other back-ends replay them (docs/results/globe_stereo.md says why one association serves them all).
 
 #include <chrono>
 #include <opencv2/core.hpp>
@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "sextant/core/observation.hpp"
+#include "sextant/core/seconds_since.hpp"
 #include "sextant/core/update_result.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/landmark_pool_policy.hpp"
@@ -124,10 +125,6 @@ class StereoTracker {
   const StereoFrontEnd& front_end() const { return front_end_; }
 
  private:
-  static double seconds_since(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  }
-
   /// The descriptor of every landmark added in this frame (and with `latest`, of every one seen);
   /// evicted ones forgotten.
   void remember_appearance(const StereoFrame& frame, const FrameAssociation& association) {
