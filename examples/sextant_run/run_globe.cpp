@@ -173,8 +173,9 @@ std::vector<BackendChoice> globe_choices(const std::vector<BackendKind>& kinds, 
       choice.label = "GraphSLAM, windows 50 x 5";
       if (c.globe.graph_batch) choices.push_back(choice);
       online.graph.incremental = true;
+      online.graph.lag = c.globe.graph_lag;
       online.key = "graph_online";
-      online.label = "GraphSLAM, online";
+      online.label = c.globe.graph_lag > 0 ? "GraphSLAM, lag " + std::to_string(c.globe.graph_lag) : "GraphSLAM, online";
       if (c.globe.graph_online) choices.push_back(std::move(online));
       continue;
     }

@@ -56,6 +56,7 @@ struct GlobeSettings {
   int graph_updates = 10;              ///< GraphSLAM global updates after the windowed initialization
   bool graph_batch = true;             ///< [globe] graph: the thesis's batch GraphSLAM row
   bool graph_online = false;           ///< [globe] graph: the online (incremental) GraphSLAM row
+  std::size_t graph_lag = 0;           ///< [globe] graph_lag: the online row's fixed lag (0: exact)
   /// globe-stereo and stereo:DIR: the back-end that tracks the images online and gates the association
   BackendKind tracker = BackendKind::ekf;
   /// [globe] tracker_gate: a SEIF tracker gates with the exact joint marginal (a factorization of
@@ -338,6 +339,10 @@ inline std::vector<ConfigKey> globe_graph_keys() {
        c.globe.graph_batch = v != "online";
        c.globe.graph_online = v != "batch";
      }},
+    {"globe", "graph_lag", "0",
+     "the online row's fixed lag: one Gauss-Newton step a frame over the newest this many poses, older "
+     "ones marginalized (a frame's cost bounded however long the tracks); 0 = the exact incremental smoother",
+     [](RunnerConfig& c, const std::string& v) { c.globe.graph_lag = parse_integer<std::size_t>(v, 0, 1e6); }},
   };
 }
 

@@ -140,6 +140,79 @@ TEST(GraphSlamOnline, RemovedLandmarksKeepTheirInformation) {
   EXPECT_LT(largest_difference(online, batch), 1e-9);
 }
 
+/// The fixed-lag mode (GraphOptions::lag) on the linear corridor, where each landmark is in view over
+/// six frames and never again: marginalizing the poses that leave the window (and the landmarks
+/// no window pose sees) is exact on a linear problem, so after every frame the window's poses, the
+/// landmarks they see and pose()'s covariance must equal the batch optimum of the frames so far,
+/// with the lag (4) shorter than a landmark's track, so that the prior carries landmarks still in view.
+/// Removals (the bounded pool) marginalize the landmark into the prior, as the batch's linear factor.
+void expect_fixed_lag_equals_the_batch(std::size_t remove_every) {
+  constexpr std::size_t lag = 4;
+  const auto steps = corridor_steps(60);
+  Graph online{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.lag = lag}};
+  Graph batch{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.max_iterations = 1}};
+  double worst_mean = 0.0, worst_cov = 0.0;
+  std::size_t compared_landmarks = 0;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    for (Graph* graph : {&online, &batch}) {
+      graph->predict(steps[k].control, steps[k].dt);
+      graph->update(steps[k].observations);
+      if (remove_every > 0 && k % remove_every == remove_every - 1) graph->remove_landmark(graph->landmark_ids()[k % graph->num_landmarks()]);
+    }
+    Graph solved = batch;
+    solved.optimize();
+    const std::size_t newest = k + 1, first = newest + 1 > lag ? newest + 1 - lag : 0;
+    EXPECT_EQ(online.last_online_step().first_row, first == 0 ? 0 : first - 1) << k;  // the step's window, before it slid
+    for (std::size_t p = first; p <= newest; ++p)
+      worst_mean = std::max(worst_mean, (online.pose_means()[p] - solved.pose_means()[p]).cwiseAbs().maxCoeff());
+    const auto means = online.landmark_means();
+    const std::map<LandmarkId, Eigen::Vector2d> ours(means.begin(), means.end());
+    for (std::size_t back = 0; back < lag && back <= k; ++back)
+      for (const auto& observation : steps[k - back].observations)
+        if (ours.contains(observation.landmark_id)) {
+          const Eigen::Vector2d theirs = solved.landmark(observation.landmark_id).mean;
+          worst_mean = std::max(worst_mean, (ours.at(observation.landmark_id) - theirs).cwiseAbs().maxCoeff());
+          ++compared_landmarks;
+        }
+    worst_cov = std::max(worst_cov, (online.pose().cov - solved.trajectory().back().cov).cwiseAbs().maxCoeff());
+  }
+  std::printf("fixed lag - batch: means %.3g, newest covariance %.3g (%zu landmark comparisons)\n", worst_mean, worst_cov,
+              compared_landmarks);
+  EXPECT_GT(compared_landmarks, 500u);
+  EXPECT_LT(worst_mean, 1e-9);
+  EXPECT_LT(worst_cov, 1e-9);
+}
+
+TEST(GraphSlamFixedLag, EqualsTheBatchOptimumOnTheWindowOfALinearCorridor) { expect_fixed_lag_equals_the_batch(0); }
+
+TEST(GraphSlamFixedLag, RemovedLandmarksKeepTheirInformation) { expect_fixed_lag_equals_the_batch(9); }
+
+/// Landmarks that leave the window and come back (each one skips every third frame; lag 1: every
+/// frame retires the landmarks it did not see and brings back those it sees again with their marginal
+/// as a prior, docs/derivations/fixed_lag_graph_slam.md). The re-entering marginal drops its
+/// correlation with what was marginalized with it, so the estimate is no longer the batch's; margin:
+/// every frame's newest pose within 3 of the batch's marginal standard deviations of the batch optimum
+/// (the estimate's own uncertainty), its covariance positive definite and finite.
+TEST(GraphSlamFixedLag, LandmarksSeenAgainAfterTheyLeftTheWindowBringTheirMarginalBack) {
+  const auto steps = test::random_linear_steps(40, 6, 7);
+  Graph online{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.lag = 1}};
+  double worst = 0.0;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    online.predict(steps[k].control, steps[k].dt);
+    ASSERT_NO_THROW(online.update(steps[k].observations)) << k;
+    Graph batch{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.max_iterations = 1}};
+    eval::run(batch, std::span(steps).first(k + 1));
+    batch.optimize();
+    const auto newest = batch.trajectory().back();
+    ASSERT_TRUE(online.pose().cov.allFinite()) << k;
+    ASSERT_EQ(Eigen::LLT<Eigen::Matrix2d>(online.pose().cov).info(), Eigen::Success) << k;
+    const Eigen::Vector2d sigma = newest.cov.diagonal().cwiseSqrt();
+    worst = std::max(worst, (online.pose().mean - newest.mean).cwiseAbs().cwiseQuotient(sigma).maxCoeff());
+  }
+  std::printf("fixed lag 1 - batch, newest pose: %.3f marginal standard deviations at most\n", worst);
+  EXPECT_LT(worst, 3.0);
+}
+
 TEST(GraphSlamOnline, RejectsANonPositiveRelinearizationThreshold) {
   EXPECT_THROW((Graph{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior,
                       {.incremental = true, .relinearize_threshold = 0.0}}),

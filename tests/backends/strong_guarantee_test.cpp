@@ -157,6 +157,11 @@ struct GraphOnline {
     return GraphSlam<FaultyMotion, FaultySensor>{FaultyMotion{}, FaultySensor{}, test::kLinearPrior, {.incremental = true}};
   }
 };
+struct GraphFixedLag {
+  static auto make() {
+    return GraphSlam<FaultyMotion, FaultySensor>{FaultyMotion{}, FaultySensor{}, test::kLinearPrior, {.lag = 3}};
+  }
+};
 struct FastSlamOne {
   static auto make() {
     return FastSlam<FaultyMotion, FaultySensor>{FaultyMotion{}, FaultySensor{}, test::kLinearPrior,
@@ -225,7 +230,7 @@ class StrongGuarantee : public ::testing::Test {
 };
 
 using Configs = ::testing::Types<EkfBatch, EkfSequential, EkfJoseph, SeifSparsified, SeifRelocalization, SeifCoordinateDescent, Graph,
-                                 GraphOnline, FastSlamOne, FastSlamTwo>;
+                                 GraphOnline, GraphFixedLag, FastSlamOne, FastSlamTwo>;
 TYPED_TEST_SUITE(StrongGuarantee, Configs);
 
 /// 10 steps on the linear test problem, a removal every third step (the removed id comes back

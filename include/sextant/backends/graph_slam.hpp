@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -25,6 +26,7 @@
 #include "sextant/core/update_result.hpp"
 #include "sextant/core/versioned_cache.hpp"
 #include "sextant/backends/detail/graph_slam_online_state.hpp"
+#include "sextant/backends/detail/graph_slam_lag_state.hpp"
 
 namespace sextant {
 
@@ -63,6 +65,12 @@ struct GraphOptions {
   /// share of its standard deviation in some coordinate: a pose's as it entered the graph (dead
   /// reckoning from the previous estimate), a landmark's given the poses (its information diagonal).
   double relinearize_threshold = 0.1;
+  /// Fixed-lag mode (docs/derivations/fixed_lag_graph_slam.md; turns the online mode on): every update()
+  /// takes one Gauss-Newton step over the newest `lag` poses and the landmarks they see, everything
+  /// older marginalized into one dense prior, so that a frame costs the same however long the tracks
+  /// and the trajectory (approximate: marginalized variables keep the estimate they left with). 0: the
+  /// exact online mode above.
+  std::size_t lag = 0;
 };
 
 /// What optimize() reports.
@@ -139,7 +147,8 @@ class GraphSlam {
   const GraphOptions& options() const { return options_; }
   /// Symbolic analyses done by the sparse solver so far (it keeps one while the pattern is unchanged).
   int symbolic_analyses() const { return solver_.analyses(); }
-  /// Online mode: what the last update() did (rows refactorized, variables relinearized).
+  /// Online mode: what the last update() did (rows refactorized, variables relinearized); fixed-lag
+  /// mode: first_row is the step's oldest pose, linearized_landmarks the landmarks in its window.
   const OnlineStepSummary& last_online_step() const { return online_.last_step; }
 
  private:
@@ -215,6 +224,26 @@ class GraphSlam {
                                           const Eigen::LLT<Eigen::Matrix<double, M, M>>& H, const Landmark& b_j,
                                           PoseAt&& pose_at) const;
   void remove_landmark_online(std::size_t slot, std::optional<typename Online::PoseFactor> held);
+  // Fixed-lag mode (graph_slam_lag_impl.hpp)
+  using Lag = FixedLagState<X, M, State>;
+  using LagSys = LagSystem<X, M>;
+  struct LagEstimate;
+  struct LagPlan;
+  std::vector<std::size_t> lag_slots(const std::vector<std::size_t>& touched_slots) const;
+  void add_lag_prior(LagSys& sys, const LagEstimate& at, const typename Lag::Prior& prior) const;
+  void add_lag_pose_prior(LagSys& sys, const LagEstimate& at) const;
+  void add_lag_motion(LagSys& sys, const LagEstimate& at, std::size_t k) const;
+  void add_lag_measurements(LagSys& sys, const LagEstimate& at, std::size_t slot, std::size_t from,
+                               std::size_t to) const;
+  void add_retired_prior(LagSys& sys, const LagEstimate& at, std::size_t slot, const Lag& window) const;
+  LagSys lag_system(const std::vector<std::size_t>& slots, const LagEstimate& at) const;
+  std::string lag_variable_at(const LagSys& sys, Eigen::Index row) const;
+  typename Lag::Prior marginalized_prior(std::optional<std::size_t> pose, const std::vector<std::size_t>& slots,
+                                            const LagEstimate& at, const Lag& window) const;
+  void slide_window(LagPlan& plan, const std::vector<std::size_t>& slots, const LagSys& sys,
+                    const Eigen::LLT<Eigen::MatrixXd>& llt) const;
+  void step_lag(const std::vector<std::size_t>& touched_slots);
+  Lag lag_without(std::size_t slot) const;
 
   Motion motion_;
   Sensor sensor_;
@@ -233,12 +262,14 @@ class GraphSlam {
   mutable SparseCholesky solver_;  ///< keeps the symbolic analysis while the pattern is unchanged (non-const paths only)
   VersionedCache<SelectedInverse> marginals_;  ///< at revision_ (thread-safe)
   Online online_;  ///< the incrementally factorized reduced system (online mode)
+  Lag lag_;  ///< the window's prior and retired landmarks (fixed-lag mode)
 };
 
 }  // namespace sextant
 
 #include "sextant/backends/detail/graph_slam_impl.hpp"
 #include "sextant/backends/detail/graph_slam_online_impl.hpp"
+#include "sextant/backends/detail/graph_slam_lag_impl.hpp"
 
 // Compiled mode (docs/build_times.md): the shipped back-end x model pairs this header completes
 // are declared extern when the program links sextant::compiled.

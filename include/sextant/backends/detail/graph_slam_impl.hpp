@@ -66,6 +66,7 @@ GraphSlam<Motion, Sensor>::GraphSlam(Motion motion, Sensor sensor, const PoseEst
   if (!(options_.relinearize_threshold > 0.0) || !std::isfinite(options_.relinearize_threshold))
     throw invalid_input_error("GraphOptions: relinearize_threshold must be positive and finite");
   options_.measurement_loss.validate();
+  if (options_.lag > 0) options_.incremental = true;
   poses_.push_back(prior.mean);
   entry_sigma_.push_back(prior.cov.diagonal().cwiseSqrt());
 }
@@ -139,7 +140,10 @@ void GraphSlam<Motion, Sensor>::record_measurements(std::size_t pose, const std:
   }
   if (!options_.incremental) return;
   try {
-    step_online(touched);
+    if (options_.lag > 0)
+      step_lag(touched);
+    else
+      step_online(touched);
   } catch (...) {
     for (std::size_t i = 0; i < used.size(); ++i) measurements_[touched[i]].pop_back();
     measurements_.resize(old_slots);
@@ -611,7 +615,9 @@ auto GraphSlam<Motion, Sensor>::marginal_factor(std::size_t slot) const -> Linea
 template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
   const std::size_t slot = landmarks_.slot(id);
-  const bool online = options_.incremental && !online_.theta.empty();
+  const bool online = options_.incremental && options_.lag == 0 && !online_.theta.empty();
+  std::optional<Lag> lag;
+  if (options_.lag > 0) lag = lag_without(slot);
   std::optional<LinearFactor> factor;
   std::optional<typename Online::PoseFactor> held;  // online: the factor's blocks of S
   if (!online) {
@@ -624,6 +630,7 @@ void GraphSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
   }
   if (factor) linear_factors_.push_back(std::move(*factor));
   if (online) remove_landmark_online(slot, std::move(held));
+  if (lag) lag_ = std::move(*lag);
   const auto removal = landmarks_.remove(id);
   measurements_[removal.freed_slot] = std::move(measurements_[removal.last_slot]);
   measurements_.pop_back();

@@ -1,0 +1,92 @@
+#pragma once
+/// \file GraphSLAM's fixed-lag mode (GraphOptions::lag), the model-independent part: the prior the
+/// marginalized variables leave on the window, the marginals of landmarks that left it, and the
+/// dense system of a set of variables (docs/derivations/fixed_lag_graph_slam.md).
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "sextant/core/error.hpp"
+#include "sextant/core/observation.hpp"
+
+namespace sextant {
+
+/// The dense normal equations H delta = b over an ordered set of variables: landmarks (by slot) and
+/// poses (by index), each placed where it was added.
+template <int X, int M>
+struct LagSystem {
+  std::unordered_map<std::size_t, Eigen::Index> landmark_at;
+  std::map<std::size_t, Eigen::Index> pose_at;
+  Eigen::Index dims = 0;
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+
+  void add_landmark(std::size_t slot) {
+    if (landmark_at.emplace(slot, dims).second) dims += M;
+  }
+  void add_pose(std::size_t pose) {
+    if (pose_at.emplace(pose, dims).second) dims += X;
+  }
+  bool has_landmark(std::size_t slot) const { return landmark_at.contains(slot); }
+  bool has_pose(std::size_t pose) const { return pose_at.contains(pose); }
+  /// Zero H and b once every variable is placed.
+  void allocate() {
+    H.setZero(dims, dims);
+    b.setZero(dims);
+  }
+  /// H[i, k] += block and, off the diagonal, H[k, i] += block^T.
+  template <class Block>
+  void add(Eigen::Index i, Eigen::Index k, const Block& block) {
+    H.block(i, k, block.rows(), block.cols()) += block;
+    if (i != k) H.block(k, i, block.cols(), block.rows()) += block.transpose();
+  }
+};
+
+template <int X, int M, class State>
+struct FixedLagState {
+  using Landmark = Eigen::Matrix<double, M, 1>;
+  /// What the marginalized variables leave on the window: 1/2 d^T Lambda d - eta^T d over
+  /// d = (m_j - theta_j for `landmarks`, then x_p ⊖ theta_p for `poses`), linearized at theta.
+  struct Prior {
+    std::vector<LandmarkId> landmarks;
+    std::vector<Landmark> landmark_theta;
+    std::vector<std::size_t> poses;
+    std::vector<State> pose_theta;
+    Eigen::MatrixXd Lambda;
+    Eigen::VectorXd eta;
+  };
+  /// A landmark no window pose sees: its mean and marginal information when it left, the prior it
+  /// brings back should it be seen again.
+  struct Retired {
+    Landmark mean;
+    Eigen::Matrix<double, M, M> information;
+  };
+
+  std::size_t first = 0;  ///< the window's oldest pose
+  Prior prior;
+  std::unordered_map<LandmarkId, Retired> retired;
+  std::vector<std::vector<LandmarkId>> seen_from;  ///< per pose: the landmarks measured from it
+};
+
+/// Eliminates the first `removed` dimensions of sys (H = [A_rr A_rk; A_kr A_kk], b = [b_r; b_k]):
+/// Lambda = A_kk - A_kr A_rr^-1 A_rk, eta = b_k - A_kr A_rr^-1 b_r (thesis Appendix C).
+template <int X, int M>
+void schur_complement(const LagSystem<X, M>& sys, Eigen::Index removed, Eigen::MatrixXd& Lambda, Eigen::VectorXd& eta) {
+  const Eigen::Index kept = sys.dims - removed;
+  const Eigen::LLT<Eigen::MatrixXd> A_rr(sys.H.topLeftCorner(removed, removed));
+  if (A_rr.info() != Eigen::Success)
+    throw numerical_error("GraphSLAM (fixed lag): the information of the variables to marginalize is not positive definite");
+  const Eigen::MatrixXd solved = A_rr.solve(sys.H.topRightCorner(removed, kept));
+  Lambda = sys.H.bottomRightCorner(kept, kept) - sys.H.bottomLeftCorner(kept, removed) * solved;
+  Lambda = (0.5 * (Lambda + Lambda.transpose())).eval();
+  eta = sys.b.tail(kept) - solved.transpose() * sys.b.head(removed);
+  if (!Lambda.allFinite() || !eta.allFinite()) throw numerical_error("GraphSLAM (fixed lag): the marginalization is not finite");
+}
+
+}  // namespace sextant
