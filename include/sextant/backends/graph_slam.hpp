@@ -227,6 +227,7 @@ class GraphSlam {
   // Fixed-lag mode (graph_slam_lag_impl.hpp)
   using Lag = FixedLagState<X, M, State>;
   using LagSys = LagSystem<X, M>;
+  using LagSolve = LagSolution<X, M>;
   struct LagEstimate;
   struct LagPlan;
   std::vector<std::size_t> lag_slots(const std::vector<std::size_t>& touched_slots) const;
@@ -241,7 +242,8 @@ class GraphSlam {
   typename Lag::Prior marginalized_prior(std::optional<std::size_t> pose, const std::vector<std::size_t>& slots,
                                             const LagEstimate& at, const Lag& window) const;
   void slide_window(LagPlan& plan, const std::vector<std::size_t>& slots, const LagSys& sys,
-                    const Eigen::LLT<Eigen::MatrixXd>& llt) const;
+                    const LagSolve& solved) const;
+  bool in_lag_prior(std::size_t slot) const;
   void step_lag(const std::vector<std::size_t>& touched_slots);
   Lag lag_without(std::size_t slot) const;
 

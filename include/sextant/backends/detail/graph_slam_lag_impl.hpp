@@ -28,6 +28,13 @@ struct GraphSlam<Motion, Sensor>::LagPlan {
   Eigen::Matrix<double, X, X> newest_cov;
 };
 
+/// Whether the landmark in `slot` is one of the prior's variables.
+template <class Motion, class Sensor>
+bool GraphSlam<Motion, Sensor>::in_lag_prior(std::size_t slot) const {
+  const LandmarkId id = landmarks_.id_at(slot);
+  return std::find(lag_.prior.landmarks.begin(), lag_.prior.landmarks.end(), id) != lag_.prior.landmarks.end();
+}
+
 /// The landmark slots the window's poses (first .. newest) measured, in slot order; `touched` are the
 /// newest frame's.
 template <class Motion, class Sensor>
@@ -132,13 +139,16 @@ void GraphSlam<Motion, Sensor>::add_retired_prior(LagSys& sys, const LagEstimate
   sys.b.template segment<M>(j) -= it->second.information * (at.landmark(slot) - it->second.mean);
 }
 
-/// The window's normal equations at `at`: the landmarks `slots`, then the poses first .. newest
-/// (the newest last, so that its marginal is the factor's last block), with every factor on them.
+/// The window's normal equations at `at`: the landmarks `slots` (those without a factor on another
+/// landmark first: the prior's last), then the poses first .. newest (the newest last, so that its
+/// marginal is the factor's last block), with every factor on them.
 template <class Motion, class Sensor>
 auto GraphSlam<Motion, Sensor>::lag_system(const std::vector<std::size_t>& slots, const LagEstimate& at) const
     -> LagSys {
   const std::size_t first = lag_.first, last = poses_.size() - 1;
   LagSys sys;
+  for (std::size_t slot : slots)
+    if (!in_lag_prior(slot)) sys.add_landmark(slot);
   for (std::size_t slot : slots) sys.add_landmark(slot);
   for (std::size_t p = first; p <= last; ++p) sys.add_pose(p);
   sys.allocate();
@@ -233,7 +243,7 @@ auto GraphSlam<Motion, Sensor>::marginalized_prior(std::optional<std::size_t> po
 /// pose saw (they retire with their marginal from the step's system), at the plan's estimate.
 template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::slide_window(LagPlan& plan, const std::vector<std::size_t>& slots, const LagSys& sys,
-                                             const Eigen::LLT<Eigen::MatrixXd>& llt) const {
+                                             const LagSolve& solved) const {
   const std::size_t last = poses_.size() - 1;
   const LagEstimate at{&plan.poses, &plan.means};
   while (last + 1 - plan.window.first > options_.lag) {
@@ -243,10 +253,7 @@ void GraphSlam<Motion, Sensor>::slide_window(LagPlan& plan, const std::vector<st
       if (measurements_[slot].back().pose == p) leaving.push_back(slot);
     auto prior = marginalized_prior(p, leaving, at, plan.window);
     for (std::size_t slot : leaving) {
-      const Eigen::Index j = sys.landmark_at.at(slot);
-      Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(sys.dims, M);
-      unit.middleRows(j, M).setIdentity();
-      const Eigen::Matrix<double, M, M> cov = symmetrized(Eigen::Matrix<double, M, M>(llt.solve(unit).middleRows(j, M)));
+      const Eigen::Matrix<double, M, M> cov = symmetrized(solved.landmark_covariance(sys, sys.landmark_at.at(slot)));
       const Eigen::Matrix<double, M, M> information = cholesky_or_throw(cov, "marginal covariance of landmark " + std::to_string(landmarks_.id_at(slot)))
                                    .solve(Eigen::Matrix<double, M, M>::Identity());
       plan.window.retired[landmarks_.id_at(slot)] = {at.landmark(slot), symmetrized(information)};
@@ -265,11 +272,10 @@ void GraphSlam<Motion, Sensor>::step_lag(const std::vector<std::size_t>& touched
   const std::size_t first = lag_.first, last = poses_.size() - 1;
   const std::vector<std::size_t> slots = lag_slots(touched);
   const LagSys sys = lag_system(slots, {&poses_, &landmarks_.means().stacked()});
-  const Eigen::LLT<Eigen::MatrixXd> llt(sys.H);
-  if (llt.info() != Eigen::Success)
-    throw numerical_error("GraphSLAM (fixed lag): the window's information matrix is not positive definite");
-  const Eigen::VectorXd delta = llt.solve(sys.b);
-  if (!delta.allFinite()) throw numerical_error("GraphSLAM (fixed lag): the step is not finite");
+  Eigen::Index free_dims = sys.pose_at.at(first);  // the prior's landmarks follow the free ones
+  for (LandmarkId id : lag_.prior.landmarks) free_dims = std::min(free_dims, sys.landmark_at.at(landmarks_.slot(id)));
+  const LagSolve solved(sys, free_dims, sys.pose_at.at(first));
+  const Eigen::VectorXd& delta = solved.delta;
   LagPlan plan{poses_, landmarks_.means().stacked(), lag_, {}};
   for (std::size_t p = first; p <= last; ++p) {
     plan.poses[p] = Space::plus(poses_[p], delta.template segment<X>(sys.pose_at.at(p)));
@@ -277,13 +283,10 @@ void GraphSlam<Motion, Sensor>::step_lag(const std::vector<std::size_t>& touched
   }
   for (std::size_t slot : slots)
     plan.means.template segment<M>(M * static_cast<Eigen::Index>(slot)) += delta.template segment<M>(sys.landmark_at.at(slot));
-  const Eigen::Matrix<double, X, X> L_nn =
-      llt.matrixLLT().template bottomRightCorner<X, X>().template triangularView<Eigen::Lower>();
-  plan.newest_cov = symmetrized(cholesky_or_throw(Eigen::Matrix<double, X, X>(L_nn * L_nn.transpose()), "newest pose's information")
-                                    .solve(Eigen::Matrix<double, X, X>::Identity()));
+  plan.newest_cov = symmetrized(solved.newest_pose_covariance());
   plan.window.seen_from.resize(poses_.size());
   for (std::size_t slot : touched) plan.window.seen_from[last].push_back(landmarks_.id_at(slot));
-  slide_window(plan, slots, sys, llt);
+  slide_window(plan, slots, sys, solved);
   poses_ = std::move(plan.poses);
   landmarks_.means().stacked() = std::move(plan.means);
   lag_ = std::move(plan.window);

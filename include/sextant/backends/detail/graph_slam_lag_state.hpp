@@ -74,6 +74,68 @@ struct FixedLagState {
   std::vector<std::vector<LandmarkId>> seen_from;  ///< per pose: the landmarks measured from it
 };
 
+/// The window's system solved with its free landmarks (the first `free_dims` dimensions: landmarks
+/// without a factor on another landmark, i.e. not in the prior) eliminated by their own Schur
+/// complements onto the poses (thesis eqs. 66-69), and one dense factorization of the rest,
+/// S = (prior landmarks, poses), the poses from `pose_begin` to the end, the newest last.
+template <int X, int M>
+struct LagSolution {
+  using Block = Eigen::Matrix<double, M, M>;
+  Eigen::Index free_dims = 0, pose_begin = 0;
+  std::vector<Eigen::LLT<Block>> free;  ///< H_jj of each free landmark
+  Eigen::LLT<Eigen::MatrixXd> S;
+  Eigen::VectorXd delta;
+
+  LagSolution(const LagSystem<X, M>& sys, Eigen::Index free_dims_, Eigen::Index pose_begin_)
+      : free_dims(free_dims_), pose_begin(pose_begin_) {
+    const Eigen::Index rest = sys.dims - free_dims, poses = sys.dims - pose_begin;
+    Eigen::MatrixXd reduced = sys.H.bottomRightCorner(rest, rest);
+    Eigen::VectorXd g = sys.b.tail(rest);
+    for (Eigen::Index o = 0; o < free_dims; o += M) {
+      free.emplace_back(Block(sys.H.template block<M, M>(o, o)));
+      if (free.back().info() != Eigen::Success)
+        throw numerical_error("GraphSLAM (fixed lag): the information of a landmark in the window is not positive definite");
+      const auto B = sys.H.block(pose_begin, o, poses, M);  // the poses' coupling; no other landmark's
+      reduced.bottomRightCorner(poses, poses).noalias() -= B * free.back().solve(B.transpose());
+      g.tail(poses).noalias() -= B * free.back().solve(sys.b.template segment<M>(o));
+    }
+    S.compute(reduced);
+    if (S.info() != Eigen::Success)
+      throw numerical_error("GraphSLAM (fixed lag): the window's information matrix is not positive definite");
+    delta.resize(sys.dims);
+    delta.tail(rest) = S.solve(g);
+    for (Eigen::Index o = 0; o < free_dims; o += M) {
+      const auto B = sys.H.block(pose_begin, o, poses, M);
+      delta.template segment<M>(o) =
+          free[static_cast<std::size_t>(o / M)].solve(sys.b.template segment<M>(o) - B.transpose() * delta.tail(poses));
+    }
+    if (!delta.allFinite()) throw numerical_error("GraphSLAM (fixed lag): the step is not finite");
+  }
+
+  /// The newest pose's marginal: (L_nn L_nn^T)^-1 from the last block of S's factor.
+  Eigen::Matrix<double, X, X> newest_pose_covariance() const {
+    const Eigen::Matrix<double, X, X> L_nn = S.matrixLLT().template bottomRightCorner<X, X>().template triangularView<Eigen::Lower>();
+    const Eigen::LLT<Eigen::Matrix<double, X, X>> information(L_nn * L_nn.transpose());
+    if (information.info() != Eigen::Success) throw numerical_error("GraphSLAM (fixed lag): the newest pose's information is not positive definite");
+    return information.solve(Eigen::Matrix<double, X, X>::Identity());
+  }
+
+  /// The marginal covariance of the landmark at `offset` in sys: a block of S^-1, or for a free one
+  /// H_jj^-1 + V^T S^-1 V with V = (0; B H_jj^-1) over S's dimensions.
+  Block landmark_covariance(const LagSystem<X, M>& sys, Eigen::Index offset) const {
+    const Eigen::Index rest = sys.dims - free_dims, poses = sys.dims - pose_begin;
+    Eigen::MatrixXd V = Eigen::MatrixXd::Zero(rest, M);
+    if (offset >= free_dims) {
+      V.middleRows(offset - free_dims, M).setIdentity();
+      return Block(S.solve(V).middleRows(offset - free_dims, M));
+    }
+    const auto& H_jj = free[static_cast<std::size_t>(offset / M)];
+    const Block H_inv = H_jj.solve(Block::Identity());
+    V.bottomRows(poses) = sys.H.block(pose_begin, offset, poses, M) * H_inv;
+    return H_inv + V.transpose() * S.solve(V);
+  }
+};
+
 /// Eliminates the first `removed` dimensions of sys (H = [A_rr A_rk; A_kr A_kk], b = [b_r; b_k]):
 /// Lambda = A_kk - A_kr A_rr^-1 A_rk, eta = b_k - A_kr A_rr^-1 b_r (thesis Appendix C).
 template <int X, int M>
