@@ -100,12 +100,7 @@ void GraphSlam<Motion, Sensor>::add_lag_pose_prior(LagSys& sys, const LagEstimat
 template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::add_lag_motion(LagSys& sys, const LagEstimate& at, std::size_t k) const {
   const auto info = motion_information(k, at.pose(k), at.pose(k + 1));
-  const Eigen::Index i = sys.pose_at.at(k), j = sys.pose_at.at(k + 1);
-  sys.add(i, i, info.aa);
-  sys.add(j, j, info.bb);
-  sys.add(i, j, info.ab);
-  sys.b.template segment<X>(i) += info.a;
-  sys.b.template segment<X>(j) += info.b;
+  sys.add_factor(sys.pose_at.at(k), sys.pose_at.at(k + 1), info);
 }
 
 /// The landmark's measurements from poses from .. to (eqs. 62-63); one the model cannot evaluate
@@ -119,12 +114,7 @@ void GraphSlam<Motion, Sensor>::add_lag_measurements(LagSys& sys, const LagEstim
     if (record->pose > to) continue;
     const auto info = measurement_information(slot, record->z, at.pose(record->pose), at.landmark(slot));
     if (!info) continue;
-    const Eigen::Index i = sys.pose_at.at(record->pose);
-    sys.add(i, i, info->aa);
-    sys.add(j, j, info->bb);
-    sys.add(i, j, info->ab);
-    sys.b.template segment<X>(i) += info->a;
-    sys.b.template segment<M>(j) += info->b;
+    sys.add_factor(sys.pose_at.at(record->pose), j, *info);
   }
 }
 

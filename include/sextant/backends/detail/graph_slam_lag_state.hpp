@@ -12,7 +12,10 @@
 #include <unordered_map>
 #include <vector>
 
+#include "sextant/core/dense_cholesky.hpp"
 #include "sextant/core/error.hpp"
+#include "sextant/core/factor_information.hpp"
+#include "sextant/core/gaussian.hpp"
 #include "sextant/core/observation.hpp"
 
 namespace sextant {
@@ -33,8 +36,6 @@ struct LagSystem {
   void add_pose(std::size_t pose) {
     if (pose_at.emplace(pose, dims).second) dims += X;
   }
-  bool has_landmark(std::size_t slot) const { return landmark_at.contains(slot); }
-  bool has_pose(std::size_t pose) const { return pose_at.contains(pose); }
   /// Zero H and b once every variable is placed.
   void allocate() {
     H.setZero(dims, dims);
@@ -45,6 +46,15 @@ struct LagSystem {
   void add(Eigen::Index i, Eigen::Index k, const Block& block) {
     H.block(i, k, block.rows(), block.cols()) += block;
     if (i != k) H.block(k, i, block.cols(), block.rows()) += block.transpose();
+  }
+  /// A factor on the variables at offsets i (dimension NA) and j (NB): its blocks of H and b.
+  template <int NA, int NB>
+  void add_factor(Eigen::Index i, Eigen::Index j, const FactorInformation<NA, NB>& info) {
+    add(i, i, info.aa);
+    add(j, j, info.bb);
+    add(i, j, info.ab);
+    b.template segment<NA>(i) += info.a;
+    b.template segment<NB>(j) += info.b;
   }
 };
 
@@ -83,27 +93,22 @@ struct LagSolution {
   using Block = Eigen::Matrix<double, M, M>;
   Eigen::Index free_dims = 0, pose_begin = 0;
   std::vector<Eigen::LLT<Block>> free;  ///< H_jj of each free landmark
-  Eigen::LLT<Eigen::MatrixXd> S;
+  Eigen::MatrixXd factor;  ///< S's Cholesky factor in its lower triangle (core/dense_cholesky.hpp)
   Eigen::VectorXd delta;
 
   LagSolution(const LagSystem<X, M>& sys, Eigen::Index free_dims_, Eigen::Index pose_begin_)
       : free_dims(free_dims_), pose_begin(pose_begin_) {
     const Eigen::Index rest = sys.dims - free_dims, poses = sys.dims - pose_begin;
-    Eigen::MatrixXd reduced = sys.H.bottomRightCorner(rest, rest);
+    factor = sys.H.bottomRightCorner(rest, rest);
     Eigen::VectorXd g = sys.b.tail(rest);
     for (Eigen::Index o = 0; o < free_dims; o += M) {
-      free.emplace_back(Block(sys.H.template block<M, M>(o, o)));
-      if (free.back().info() != Eigen::Success)
-        throw numerical_error("GraphSLAM (fixed lag): the information of a landmark in the window is not positive definite");
+      free.push_back(cholesky_or_throw(sys.H.template block<M, M>(o, o), "GraphSLAM (fixed lag): the information of a landmark in the window"));
       const auto B = sys.H.block(pose_begin, o, poses, M);  // the poses' coupling; no other landmark's
-      reduced.bottomRightCorner(poses, poses).noalias() -= B * free.back().solve(B.transpose());
+      factor.bottomRightCorner(poses, poses).noalias() -= B * free.back().solve(B.transpose());
       g.tail(poses).noalias() -= B * free.back().solve(sys.b.template segment<M>(o));
     }
-    S.compute(reduced);
-    if (S.info() != Eigen::Success)
-      throw numerical_error("GraphSLAM (fixed lag): the window's information matrix is not positive definite");
     delta.resize(sys.dims);
-    delta.tail(rest) = S.solve(g);
+    delta.tail(rest) = cholesky_in_place_or_throw(factor, "GraphSLAM (fixed lag): the window's information matrix").solve(g);
     for (Eigen::Index o = 0; o < free_dims; o += M) {
       const auto B = sys.H.block(pose_begin, o, poses, M);
       delta.template segment<M>(o) =
@@ -112,18 +117,19 @@ struct LagSolution {
     if (!delta.allFinite()) throw numerical_error("GraphSLAM (fixed lag): the step is not finite");
   }
 
-  /// The newest pose's marginal: (L_nn L_nn^T)^-1 from the last block of S's factor.
+  /// The newest pose's marginal: (L_nn L_nn^T)^-1 from the last block of S's factor, since L^-1 is
+  /// lower triangular (as ProfileCholesky::last_inverse_block).
   Eigen::Matrix<double, X, X> newest_pose_covariance() const {
-    const Eigen::Matrix<double, X, X> L_nn = S.matrixLLT().template bottomRightCorner<X, X>().template triangularView<Eigen::Lower>();
-    const Eigen::LLT<Eigen::Matrix<double, X, X>> information(L_nn * L_nn.transpose());
-    if (information.info() != Eigen::Success) throw numerical_error("GraphSLAM (fixed lag): the newest pose's information is not positive definite");
-    return information.solve(Eigen::Matrix<double, X, X>::Identity());
+    const Eigen::Matrix<double, X, X> L_inv = factor.template bottomRightCorner<X, X>().template triangularView<Eigen::Lower>().solve(
+        Eigen::Matrix<double, X, X>::Identity());
+    return L_inv.transpose() * L_inv;
   }
 
   /// The marginal covariance of the landmark at `offset` in sys: a block of S^-1, or for a free one
   /// H_jj^-1 + V^T S^-1 V with V = (0; B H_jj^-1) over S's dimensions.
   Block landmark_covariance(const LagSystem<X, M>& sys, Eigen::Index offset) const {
     const Eigen::Index rest = sys.dims - free_dims, poses = sys.dims - pose_begin;
+    const LowerCholeskyFactor S(factor);
     Eigen::MatrixXd V = Eigen::MatrixXd::Zero(rest, M);
     if (offset >= free_dims) {
       V.middleRows(offset - free_dims, M).setIdentity();
@@ -141,9 +147,8 @@ struct LagSolution {
 template <int X, int M>
 void schur_complement(const LagSystem<X, M>& sys, Eigen::Index removed, Eigen::MatrixXd& Lambda, Eigen::VectorXd& eta) {
   const Eigen::Index kept = sys.dims - removed;
-  const Eigen::LLT<Eigen::MatrixXd> A_rr(sys.H.topLeftCorner(removed, removed));
-  if (A_rr.info() != Eigen::Success)
-    throw numerical_error("GraphSLAM (fixed lag): the information of the variables to marginalize is not positive definite");
+  const auto A_rr = cholesky_or_throw(sys.H.topLeftCorner(removed, removed),
+                                      "GraphSLAM (fixed lag): the information of the variables to marginalize");
   const Eigen::MatrixXd solved = A_rr.solve(sys.H.topRightCorner(removed, kept));
   Lambda = sys.H.bottomRightCorner(kept, kept) - sys.H.bottomLeftCorner(kept, removed) * solved;
   Lambda = (0.5 * (Lambda + Lambda.transpose())).eval();
