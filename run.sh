@@ -51,7 +51,7 @@ case "$mode" in
     cd "$build" && exec ctest --output-on-failure -j"$jobs" "${label[@]}" "$@" ;;
   test-sanitize)
     build=${SEXTANT_SANITIZE_BUILD_DIR:-build-sanitize}
-    cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DCMAKE_CXX_COMPILER=clang++ \
+    cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DCMAKE_CXX_COMPILER=clang++ \
           -DSEXTANT_SANITIZE=address,undefined \
           -DSEXTANT_REQUIRE_ALL_DEPENDENCIES=ON -DSEXTANT_BUILD_TESTS=ON -DSEXTANT_BUILD_EXAMPLES=OFF \
           -DSEXTANT_BUILD_BENCHMARKS=OFF >/dev/null
@@ -61,14 +61,14 @@ case "$mode" in
     cd "$build" && exec ctest --output-on-failure -j"$jobs" -LE "slow|statistical|install" -E "_NOT_BUILT|^readme\\." "$@" ;;
   test-tsan)
     build=${SEXTANT_TSAN_BUILD_DIR:-build-tsan}
-    cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DSEXTANT_SANITIZE=thread \
+    cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DSEXTANT_SANITIZE=thread \
           -DSEXTANT_BUILD_TESTS=ON -DSEXTANT_BUILD_EXAMPLES=OFF -DSEXTANT_BUILD_BENCHMARKS=OFF >/dev/null
     build_targets concurrent_reads_test monte_carlo_test
     export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1}
     cd "$build" && exec ctest --output-on-failure -j"$jobs" -R "^(ConcurrentReads|MonteCarlo)" "$@" ;;
   fuzz)
     build=${SEXTANT_FUZZ_BUILD_DIR:-build-fuzz}
-    cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DCMAKE_CXX_COMPILER=clang++ \
+    cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DCMAKE_CXX_COMPILER=clang++ \
           -DSEXTANT_BUILD_FUZZERS=ON -DSEXTANT_BUILD_TESTS=OFF -DSEXTANT_BUILD_EXAMPLES=OFF -DSEXTANT_BUILD_BENCHMARKS=OFF \
           -DSEXTANT_REQUIRE_ALL_DEPENDENCIES=ON >/dev/null
     build_targets sextant_fuzzers

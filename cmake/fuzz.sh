@@ -88,15 +88,13 @@ printf "${calib}initial_state: [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0]\ninitial_sig
   > "$corpus/stereo_sequence_fuzz/with_state"
 
 summary=$build/fuzz-summary.md
-{
-  echo "| target | seconds | executions | coverage (edges) | features | corpus | findings |"
-  echo "|---|---|---|---|---|---|---|"
-} > "$summary"
-status=0
-for target in "$build"/tests/fuzz/*_fuzz; do
+# fuzz_target <target>: runs it for $seconds s; writes its summary row to $build/fuzz-<name>.row and
+# returns non-zero on a finding.
+fuzz_target() {
+  local target=$1 name rc execs cov ft units found
   name=$(basename "$target")
   mkdir -p "$corpus/$name"
-  log=$build/fuzz-$name.log
+  local log=$build/fuzz-$name.log
   echo "fuzz: $name for $seconds s"
   # -report_slow_units at the timeout: a unit slower than libFuzzer's default 10 s but under 20 s is
   # no finding (docs/reliability.md: a timeout is 20 s), only its artifact would have failed the run.
@@ -108,12 +106,33 @@ for target in "$build"/tests/fuzz/*_fuzz; do
   ft=$(grep -oE ' ft: [0-9]+' "$log" | tail -1 | awk '{print $NF}')
   units=$(ls "$corpus/$name" | wc -l)
   found=$(ls "$findings" | grep -c "^$name-" || true)
-  echo "| $name | $seconds | ${execs:-?} | ${cov:-?} | ${ft:-?} | $units | $found |" >> "$summary"
+  echo "| $name | $seconds | ${execs:-?} | ${cov:-?} | ${ft:-?} | $units | $found |" > "$build/fuzz-$name.row"
   if [ $rc -ne 0 ] || [ "$found" -ne 0 ]; then
-    status=1
     echo "fuzz: $name FAILED (exit $rc); its log: $log"
     grep -E "ERROR|runtime error|SUMMARY|uncaught|Test unit written" "$log" | head -20
+    return 1
   fi
+}
+# One target per core at a time (libFuzzer runs on one thread): each still gets its $seconds.
+jobs=$(nproc 2>/dev/null || echo 2)
+status=0
+running=0
+for target in "$build"/tests/fuzz/*_fuzz; do
+  if [ "$running" -ge "$jobs" ]; then
+    wait -n || status=1
+    running=$((running - 1))
+  fi
+  fuzz_target "$target" &
+  running=$((running + 1))
 done
+while [ "$running" -gt 0 ]; do
+  wait -n || status=1
+  running=$((running - 1))
+done
+{
+  echo "| target | seconds | executions | coverage (edges) | features | corpus | findings |"
+  echo "|---|---|---|---|---|---|---|"
+  for target in "$build"/tests/fuzz/*_fuzz; do cat "$build/fuzz-$(basename "$target").row"; done
+} > "$summary"
 cat "$summary"
 exit $status
