@@ -205,6 +205,13 @@ inline double parse_probability(const std::string& text) {
   return p;
 }
 
+/// A factor in (0, 1].
+inline double parse_fraction(const std::string& text) {
+  const double p = parse_number(text);
+  if (!(p > 0.0 && p <= 1.0)) throw invalid_input_error("'" + text + "' must be in (0, 1]");
+  return p;
+}
+
 /// A gate probability: 0 (off) or in (0, 1).
 inline double parse_gate_probability(const std::string& text) {
   const double p = parse_number(text);
@@ -395,6 +402,9 @@ inline std::vector<ConfigKey> rawlog_keys() {
      }},
     {"rawlog", "odometry_std_phi_deg", "4", "observation-only rawlogs: odometry heading noise per step, degrees",
      [](RunnerConfig& c, const std::string& v) { c.rawlog.odometry_std(2) = positive(parse_number(v), v) * deg; }},
+    {"rawlog", "at_rest_noise_scale", "0.001",
+     "a step whose odometry increment is exactly zero is at rest: its stated noise times this (1 = as stated)",
+     [](RunnerConfig& c, const std::string& v) { c.rawlog.at_rest_noise_scale = parse_fraction(v); }},
     {"rawlog", "prior_std", "1e-06", "standard deviation of the start pose (the robot starts at the map origin)",
      [](RunnerConfig& c, const std::string& v) { c.rawlog.prior_std = positive(parse_number(v), v); }},
     {"rawlog", "max_steps", "0", "read at most this many steps; 0 = all",

@@ -9,6 +9,7 @@
 ///  - observation-only rawlogs: each CObservationOdometry starts a step whose increment is the
 ///    change of the absolute odometry reading (noise from RawlogOptions, the reading has none);
 ///    CObservationBearingRange entries add to the current step.
+/// A step whose increment is exactly zero is a robot at rest (RawlogOptions::at_rest_noise_scale).
 /// The sensor mount and noise come from the CObservationBearingRange entries (or RawlogOptions)
 /// and must not change along the log. Anything the reader cannot use gives a parse_error naming
 /// the file, the entry and the problem.
@@ -138,6 +139,8 @@ class RawlogParser {
     if (options.max_steps && steps_.size() > options.max_steps) steps_.resize(options.max_steps);
     if (steps_.empty()) throw parse_error(path_ + ": no odometry step followed by observations");
     if (!sensor_.known) throw parse_error(path_ + ": no CObservationBearingRange entries");
+    for (auto& step : steps_)
+      if (step.delta.isZero(0.0)) step.cov *= options.at_rest_noise_scale * options.at_rest_noise_scale;
     return std::move(steps_);
   }
 
