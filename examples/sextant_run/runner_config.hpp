@@ -583,6 +583,10 @@ inline std::vector<ConfigKey> graph_keys() {
      [](RunnerConfig& c, const std::string& v) { c.graph.levenberg_marquardt = parse_bool(v); }},
     {"graph", "window", "0", "windowed initialization: optimize growing parts of this many steps first; 0 = off",
      [](RunnerConfig& c, const std::string& v) { c.graph.window = parse_integer<std::size_t>(v, 0); }},
+    {"graph", "reuse_retired_marginals", "false",
+     "fixed lag: a landmark seen again after it left the window comes back with the marginal it left with as a "
+     "prior (counts the closure twice: overconfident) | false: from the window's measurements alone",
+     [](RunnerConfig& c, const std::string& v) { c.graph.reuse_retired_marginals = parse_bool(v); }},
     {"graph", "relinearize_threshold", "0.1",
      "online mode: relinearize a variable when its step exceeds this share of its standard deviation",
      [](RunnerConfig& c, const std::string& v) { c.graph.relinearize_threshold = positive(parse_number(v), v); }},

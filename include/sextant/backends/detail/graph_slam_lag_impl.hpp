@@ -230,7 +230,8 @@ auto GraphSlam<Motion, Sensor>::marginalized_prior(std::optional<std::size_t> po
 }
 
 /// Marginalizes the window's oldest poses until `lag` are left, each with the landmarks no later
-/// pose saw (they retire with their marginal from the step's system), at the plan's estimate.
+/// pose saw (they retire, with their marginal from the step's system when GraphOptions::
+/// reuse_retired_marginals asks for it), at the plan's estimate.
 template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::slide_window(LagPlan& plan, const std::vector<std::size_t>& slots, const LagSys& sys,
                                              const LagSolve& solved) const {
@@ -243,6 +244,7 @@ void GraphSlam<Motion, Sensor>::slide_window(LagPlan& plan, const std::vector<st
       if (measurements_[slot].back().pose == p) leaving.push_back(slot);
     auto prior = marginalized_prior(p, leaving, at, plan.window);
     for (std::size_t slot : leaving) {
+      if (!options_.reuse_retired_marginals) continue;  // a landmark seen again starts from its window
       const Eigen::Matrix<double, M, M> cov = symmetrized(solved.landmark_covariance(sys, sys.landmark_at.at(slot)));
       const Eigen::Matrix<double, M, M> information = cholesky_or_throw(cov, "marginal covariance of landmark " + std::to_string(landmarks_.id_at(slot)))
                                    .solve(Eigen::Matrix<double, M, M>::Identity());
