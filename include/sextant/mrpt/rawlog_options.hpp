@@ -20,7 +20,7 @@ struct RawlogOptions {
   /// adds no noise to a zero increment yet states its usual covariance (the four steps at rest that
   /// open its logs and MRPT's kf-slam demos), and encoders that count no tick did not move either;
   /// read as stated, those steps blur the whole map's placement by noise that never happened
-  /// (docs/results/seif_relocalization.md, "Steps at rest"). Not 0: information-form back-ends invert it.
+  /// (docs/results/steps_at_rest.md). Not 0: information-form back-ends invert it.
   double at_rest_noise_scale = 1e-3;
   /// Standard deviation of the start pose (the robot starts at the origin of the map frame).
   double prior_std = 1e-6;

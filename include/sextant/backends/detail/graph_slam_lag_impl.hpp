@@ -243,13 +243,13 @@ void GraphSlam<Motion, Sensor>::slide_window(LagPlan& plan, const std::vector<st
     for (std::size_t slot : slots)
       if (measurements_[slot].back().pose == p) leaving.push_back(slot);
     auto prior = marginalized_prior(p, leaving, at, plan.window);
-    for (std::size_t slot : leaving) {
-      if (!options_.reuse_retired_marginals) continue;  // a landmark seen again starts from its window
-      const Eigen::Matrix<double, M, M> cov = symmetrized(solved.landmark_covariance(sys, sys.landmark_at.at(slot)));
-      const Eigen::Matrix<double, M, M> information = cholesky_or_throw(cov, "marginal covariance of landmark " + std::to_string(landmarks_.id_at(slot)))
-                                   .solve(Eigen::Matrix<double, M, M>::Identity());
-      plan.window.retired[landmarks_.id_at(slot)] = {at.landmark(slot), symmetrized(information)};
-    }
+    if (options_.reuse_retired_marginals)  // otherwise a landmark seen again starts from its window
+      for (std::size_t slot : leaving) {
+        const Eigen::Matrix<double, M, M> cov = symmetrized(solved.landmark_covariance(sys, sys.landmark_at.at(slot)));
+        const Eigen::Matrix<double, M, M> information = cholesky_or_throw(cov, "marginal covariance of landmark " + std::to_string(landmarks_.id_at(slot)))
+                                     .solve(Eigen::Matrix<double, M, M>::Identity());
+        plan.window.retired[landmarks_.id_at(slot)] = {at.landmark(slot), symmetrized(information)};
+      }
     plan.window.prior = std::move(prior);
     plan.window.seen_from[p].clear();
     plan.window.first = p + 1;
