@@ -511,6 +511,10 @@ inline std::vector<ConfigKey> ekf_keys() {
      "re-read P in the tangent at the corrected pose (G P G^T; SE(3) and world-frame SE(2) only): the error-state "
      "filter's reset, off because it fights first-estimate Jacobians (docs/derivations/state_space_jacobians.md)",
      [](RunnerConfig& c, const std::string& v) { c.ekf.tangent_reset = parse_bool(v); }},
+    {"ekf", "iterations", "1",
+     "linearizations per update, each at the previous one's correction (the iterated EKF; 1 = the textbook "
+     "EKF): docs/results/iterated_ekf.md",
+     [](RunnerConfig& c, const std::string& v) { c.ekf.iterations = parse_integer<int>(v, 1, 100); }},
   };
 }
 

@@ -53,6 +53,14 @@ TEST(EkfSlam, SequentialAndJosephUpdatesEqualBatchLeastSquaresToo) {
   expect_equals_batch(run_filter(steps, {.covariance_update = CovarianceUpdate::joseph}), batch, 1e-9);
 }
 
+// On a linear model the first Gauss-Newton step is the optimum: the iterated EKF stops after its
+// second linearization finds nothing to move, and is the Kalman filter.
+TEST(EkfSlam, IteratedUpdateOnALinearProblemIsTheKalmanUpdate) {
+  const auto steps = test::random_linear_steps(60, 6, 9);
+  const auto batch = test::solve_linear_ship_problem(kMotion, kSensor, kPrior, steps);
+  expect_equals_batch(run_filter(steps, {.iterations = 5}), batch, 1e-9);
+}
+
 TEST(EkfSlam, BlockSparseUpdateEqualsTextbookDenseUpdate) {
   const auto steps = test::random_linear_steps(10, 6, 10);
   Ekf ekf{kMotion, kSensor, kPrior};

@@ -130,6 +130,11 @@ struct EkfJoseph {
                                                {.covariance_update = CovarianceUpdate::joseph, .gate_probability = 0.999}};
   }
 };
+struct EkfIterated {
+  static auto make() {
+    return EkfSlam<FaultyMotion, FaultySensor>{FaultyMotion{}, FaultySensor{}, test::kLinearPrior, {.iterations = 3}};
+  }
+};
 struct SeifSparsified {
   static auto make() {
     return SeifSlam<FaultyMotion, FaultySensor>{FaultyMotion{}, FaultySensor{}, test::kLinearPrior, {.max_active = 3}};
@@ -229,7 +234,7 @@ class StrongGuarantee : public ::testing::Test {
   long faults_ = 0;
 };
 
-using Configs = ::testing::Types<EkfBatch, EkfSequential, EkfJoseph, SeifSparsified, SeifRelocalization, SeifCoordinateDescent, Graph,
+using Configs = ::testing::Types<EkfBatch, EkfSequential, EkfJoseph, EkfIterated, SeifSparsified, SeifRelocalization, SeifCoordinateDescent, Graph,
                                  GraphOnline, GraphFixedLag, FastSlamOne, FastSlamTwo>;
 TYPED_TEST_SUITE(StrongGuarantee, Configs);
 

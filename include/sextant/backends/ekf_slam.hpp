@@ -65,6 +65,13 @@ struct EkfOptions {
   /// gated filter that comes back from a long gap beyond its own covariance never corrects again
   /// (docs/results/mrclam.md, stress cases). Needs the gate: a min_landmarks > 0 without it throws.
   ReacquisitionOptions reacquisition{};
+  /// Iterated EKF (Bell and Cathey 1993: the update as Gauss-Newton on the prior and the step's
+  /// measurements): up to this many linearizations per update, each at the previous one's corrected
+  /// robot and landmarks, the covariance corrected once with the last Jacobians. 1 = the textbook
+  /// EKF, linearized at the prediction. Iterations cost O(n k) each beside the O(n^2 k) covariance
+  /// correction; they matter where a landmark is close to the sensor compared with the robot's
+  /// predicted uncertainty (docs/results/iterated_ekf.md).
+  int iterations = 1;
 };
 
 /// EKF-SLAM: joint Gaussian over the robot state and a growing set of landmarks. Only the lower
@@ -154,6 +161,8 @@ class EkfSlam {
 
   /// The observations the model can use here; the others go to result.unusable.
   std::vector<Linearized> linearize(std::span<const ObservationType> known, UpdateResult& result) const;
+  std::optional<Linearized> linearize_at(const ObservationType& observation, std::size_t slot, const State& x,
+                                         const Landmark& m, std::vector<LandmarkId>& unusable) const;
   Eigen::Matrix<double, Eigen::Dynamic, Z> cross_covariance(const Linearized& obs) const;
   /// H_i C: observation i's Jacobian applied to C (rows of the stacked state), from the robot and
   /// landmark rows only.
@@ -162,7 +171,15 @@ class EkfSlam {
     return obs.J_z_x * C.template topRows<X>() + obs.J_z_m * C.template middleRows<M>(obs.offset);
   }
   void gate(std::vector<Linearized>& observations, UpdateResult& result) const;
-  Correction compute_correction(const std::vector<Linearized>& observations) const;
+  /// with_covariance = false: the mean's correction only (delta, x), for the iterated EKF's iterates.
+  Correction compute_correction(const std::vector<Linearized>& observations, bool with_covariance = true) const;
+  /// The iterated EKF (EkfOptions::iterations): `observations` relinearized at its iterates.
+  void relinearize_at_iterates(std::span<const ObservationType> known, std::vector<Linearized>& observations) const;
+  /// The observations relinearized at the robot and landmarks `correction` moves to, their residual
+  /// referred back to the prior (z - h(x_i) + H_i delta_i); none when one of them is not observable there.
+  std::optional<std::vector<Linearized>> relinearize(std::span<const ObservationType> known,
+                                                     const std::vector<Linearized>& observations,
+                                                     const Correction& correction) const;
   Eigen::MatrixXd joseph_covariance(const std::vector<Linearized>& observations, const Eigen::MatrixXd& K) const;
   Plan plan(std::span<const ObservationType> known, std::span<const ObservationType> fresh, UpdateResult& result) const;
   /// update() without re-acquisition: the EKF's correction and augmentation (eqs. 14-17).

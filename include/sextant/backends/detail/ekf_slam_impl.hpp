@@ -18,6 +18,8 @@ EkfSlam<Motion, Sensor>::EkfSlam(Motion motion, Sensor sensor, const PoseEstimat
   if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
   require_constrainable<Space, Landmark>(options_.observability_constraints);
   cholesky_or_throw(prior.cov, "prior covariance");
+  if (options_.iterations < 1)
+    throw invalid_input_error("EkfOptions::iterations must be at least 1 (got " + std::to_string(options_.iterations) + ")");
   gate_ = InnovationGate(Z, options_.gate_probability);
   if (options_.reacquisition.min_landmarks != 0)  // checks the options; needs the gate
     reacquisition_ = Reacquisition(options_.reacquisition, options_.gate_probability);
@@ -88,13 +90,61 @@ auto EkfSlam<Motion, Sensor>::linearize(std::span<const ObservationType> known, 
   out.reserve(known.size());
   for (const auto& observation : known) {
     const std::size_t slot = landmarks_.slot(observation.landmark_id);
-    auto lin = linearize_if_observable(sensor_, x_, landmark_mean(slot), observation.z, observation.landmark_id,
-                                       offset_of(slot), result.unusable);
-    if (!lin) continue;
-    if (options_.first_estimate_jacobians)
-      use_first_estimate_jacobians(sensor_, x_, Landmark(landmarks_.first_mean(slot)), observation.z, *lin);
-    constrain_observation_if<Space>(options_.observability_constraints, *lin, propagated_,
-                                    Landmark(landmarks_.first_mean(slot)));
+    if (auto lin = linearize_at(observation, slot, x_, landmark_mean(slot), result.unusable)) out.push_back(std::move(*lin));
+  }
+  return out;
+}
+
+/// One observation linearized at robot state x and landmark mean m, with the Jacobians the options
+/// ask for (first estimates, observability constraints); none when the model cannot use it there.
+template <class Motion, class Sensor>
+auto EkfSlam<Motion, Sensor>::linearize_at(const ObservationType& observation, std::size_t slot, const State& x,
+                                           const Landmark& m, std::vector<LandmarkId>& unusable) const
+    -> std::optional<Linearized> {
+  auto lin = linearize_if_observable(sensor_, x, m, observation.z, observation.landmark_id, offset_of(slot), unusable);
+  if (!lin) return lin;
+  const Landmark first(landmarks_.first_mean(slot));
+  if (options_.first_estimate_jacobians) use_first_estimate_jacobians(sensor_, x, first, observation.z, *lin);
+  constrain_observation_if<Space>(options_.observability_constraints, *lin, propagated_, first);
+  return lin;
+}
+
+/// Iterated EKF: x_{i+1} = x_0 + P H_i^T S_i^-1 (z - h(x_i) + H_i (x_i - x_0)), the Gauss-Newton step
+/// on ||x - x_0||^2_P^-1 + sum ||z - h(x)||^2_Q^-1 from the iterate x_i (Bell and Cathey 1993), until
+/// the correction moves by less than 1e-9 of itself. Leaves `observations` linearized at the last
+/// iterate (an observation the model cannot use at the next one ends the iterations there); plan()
+/// then corrects with them once. A correction that fails at an iterate throws, as at the first.
+template <class Motion, class Sensor>
+void EkfSlam<Motion, Sensor>::relinearize_at_iterates(std::span<const ObservationType> known,
+                                                      std::vector<Linearized>& observations) const {
+  Correction correction = compute_correction(observations, false);
+  for (int i = 1; i < options_.iterations; ++i) {
+    auto relinearized = relinearize(known, observations, correction);
+    if (!relinearized) return;
+    Correction next = compute_correction(*relinearized, false);
+    const double moved = (next.delta - correction.delta).template lpNorm<Eigen::Infinity>();
+    observations = std::move(*relinearized);
+    correction = std::move(next);
+    if (moved <= 1e-9 * (1.0 + correction.delta.template lpNorm<Eigen::Infinity>())) return;
+  }
+}
+
+template <class Motion, class Sensor>
+auto EkfSlam<Motion, Sensor>::relinearize(std::span<const ObservationType> known,
+                                          const std::vector<Linearized>& observations,
+                                          const Correction& correction) const -> std::optional<std::vector<Linearized>> {
+  std::vector<Linearized> out;
+  out.reserve(observations.size());
+  std::vector<LandmarkId> unusable;
+  auto observation = known.begin();  // observations keep known's order (some left out)
+  const Eigen::Matrix<double, X, 1> dx = correction.delta.template head<X>();
+  for (const auto& previous : observations) {
+    while (observation->landmark_id != previous.id) ++observation;
+    const std::size_t slot = landmarks_.slot(previous.id);
+    const Eigen::Matrix<double, M, 1> dm = correction.delta.template segment<M>(previous.offset);
+    auto lin = linearize_at(*observation, slot, correction.x, Landmark(landmark_mean(slot) + dm), unusable);
+    if (!lin) return std::nullopt;
+    lin->residual += lin->J_z_x * dx + lin->J_z_m * dm;
     out.push_back(std::move(*lin));
   }
   return out;
@@ -129,7 +179,8 @@ void EkfSlam<Motion, Sensor>::gate(std::vector<Linearized>& observations, Update
 /// Thesis eqs. (14)-(16) for k observations at once: C = P H^T, S = H C + Q, delta = C S^-1 nu;
 /// and the factors of the covariance correction, checked for overflow before anything changes.
 template <class Motion, class Sensor>
-auto EkfSlam<Motion, Sensor>::compute_correction(const std::vector<Linearized>& observations) const -> Correction {
+auto EkfSlam<Motion, Sensor>::compute_correction(const std::vector<Linearized>& observations,
+                                                 bool with_covariance) const -> Correction {
   const Eigen::Index n = state_dim(), k = static_cast<Eigen::Index>(observations.size());
   Eigen::MatrixXd C(n, Z * k);
   Eigen::VectorXd nu(Z * k);
@@ -149,6 +200,7 @@ auto EkfSlam<Motion, Sensor>::compute_correction(const std::vector<Linearized>& 
   if (!out.delta.allFinite()) throw numerical_error("EKF correction is not finite");
   out.x = Space::plus(x_, out.delta.template head<X>());
   if (!Space::is_finite(out.x)) throw numerical_error("EKF correction of the robot state is not finite");
+  if (!with_covariance) return out;
   if constexpr (has_plus_jacobian_v<Space, State>) {
     if (options_.tangent_reset)
       out.reset = plus_jacobian<Space>(x_, Eigen::Matrix<double, X, 1>(out.delta.template head<X>()));
@@ -240,6 +292,7 @@ auto EkfSlam<Motion, Sensor>::plan(std::span<const ObservationType> known, std::
   gate(observations, result);
   State x_after = x_;
   if (!observations.empty()) {
+    if (options_.iterations > 1) relinearize_at_iterates(known, observations);
     out.correction = compute_correction(observations);
     x_after = out.correction->x;
     result.corrected += observations.size();
