@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <iostream>
 #include <vector>
 
 #include "sextant/backends/ekf_slam.hpp"
