@@ -550,6 +550,11 @@ inline std::vector<ConfigKey> seif_keys() {
                                            v, {{"recovered_mean", SeifEstimate::recovered_mean},
                                                {"exact_mean", SeifEstimate::exact_mean}}));
      }},
+    {"seif", "iterations", "1",
+     "linearizations per update, each at the mean the previous one recovered (the iterated SEIF; with "
+     "relocalization the whole step iterates before the robot is relocalized; 1 = the thesis's SEIF): "
+     "docs/results/iterated_ekf.md",
+     [](RunnerConfig& c, const std::string& v) { c.seif.iterations = parse_integer<int>(v, 1, 100); }},
     {"seif", "relocalization_min_information", "0.05",
      "relocalization: share of the robot's information the held-back measurements must carry in every direction",
      [](RunnerConfig& c, const std::string& v) { c.seif.relocalization_min_information = non_negative(parse_number(v), v); }},

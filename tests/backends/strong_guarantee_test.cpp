@@ -147,6 +147,15 @@ struct SeifRelocalization {
         {.max_active = 2, .sparsification = SeifSparsification::relocalization, .estimate = SeifEstimate::exact_mean}};
   }
 };
+struct SeifRelocalizationIterated {  // the iterated SEIF: every step iterated, relocalizing or not
+  static auto make() {
+    return SeifSlam<FaultyMotion, FaultySensor>{FaultyMotion{}, FaultySensor{}, test::kLinearPrior,
+                                                {.max_active = 2,
+                                                 .sparsification = SeifSparsification::relocalization,
+                                                 .estimate = SeifEstimate::exact_mean,
+                                                 .iterations = 3}};
+  }
+};
 struct SeifCoordinateDescent {
   static auto make() {
     return SeifSlam<FaultyMotion, FaultySensor>{
@@ -234,7 +243,8 @@ class StrongGuarantee : public ::testing::Test {
   long faults_ = 0;
 };
 
-using Configs = ::testing::Types<EkfBatch, EkfSequential, EkfJoseph, EkfIterated, SeifSparsified, SeifRelocalization, SeifCoordinateDescent, Graph,
+using Configs = ::testing::Types<EkfBatch, EkfSequential, EkfJoseph, EkfIterated, SeifSparsified, SeifRelocalization,
+                                 SeifRelocalizationIterated, SeifCoordinateDescent, Graph,
                                  GraphOnline, GraphFixedLag, FastSlamOne, FastSlamTwo>;
 TYPED_TEST_SUITE(StrongGuarantee, Configs);
 

@@ -12,7 +12,7 @@
 #include "sextant/core/landmark_store.hpp"
 #include "sextant/core/rollback_guard.hpp"
 #include "sextant/core/concepts.hpp"
-#include "sextant/core/first_estimates.hpp"
+#include "sextant/core/filter_linearization.hpp"
 #include "sextant/core/observability_constraints.hpp"
 #include "sextant/core/pose_reacquisition.hpp"
 #include "sextant/core/gaussian.hpp"

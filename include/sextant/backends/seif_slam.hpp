@@ -17,7 +17,7 @@
 #include "sextant/core/landmark_store.hpp"
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/conditionally_linear.hpp"
-#include "sextant/core/first_estimates.hpp"
+#include "sextant/core/filter_linearization.hpp"
 #include "sextant/core/observability_constraints.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/innovation_gate.hpp"
@@ -101,6 +101,14 @@ struct SeifOptions {
   /// Observability constraints, as EkfOptions::observability_constraints (OC-EKF in information form:
   /// the constrained G and H enter the motion and measurement updates unchanged otherwise).
   bool observability_constraints = false;
+  /// Linearizations of each update's measurements: 1 (the default) is the thesis's SEIF, linearized at
+  /// the prediction; k > 1 is the iterated update, the information-form twin of
+  /// EkfOptions::iterations: after the mean is recovered, the step's measurements are taken out as
+  /// the linear factors they added and added again linearized at the recovered mean, up to k times
+  /// (fewer once the mean moves by < 1e-9 of its step). With relocalization the whole step is
+  /// iterated before the robot is marginalized, so the held-back measurements relocalize it from the
+  /// step's mean. Each iteration costs one more mean recovery.
+  int iterations = 1;
 };
 
 /// Wall time of one update's stages, as the thesis times them (§5.4, Tables 15-16): measurement
@@ -196,6 +204,7 @@ class SeifSlam {
   using Init = LandmarkInit<M, X, Z>;
   using Factor = SparseCholesky;  ///< the project's one sparse factorization path (CHOLMOD when linked)
   /// Information that one observation adds: H^T W H and H^T W nu by blocks, W = Q^-1.
+  /// r_x, r_m are the factor's gradient at the robot state and landmark mean it was linearized at.
   struct MeasurementInformation {
     std::size_t slot;
     Eigen::Matrix<double, X, X> xx;
@@ -203,6 +212,9 @@ class SeifSlam {
     Eigen::Matrix<double, M, M> mm;
     Eigen::Matrix<double, X, 1> r_x;
     Eigen::Matrix<double, M, 1> r_m;
+    LandmarkId id;
+    State at_x;     ///< where it was linearized: the robot state
+    Landmark at_m;  ///< and the landmark mean
   };
   /// A new landmark as the conditional m = init.m + J_m_x dx + noise with covariance J_m_z Q J_m_z^T.
   struct NewLandmark {
@@ -221,8 +233,32 @@ class SeifSlam {
   MeasurementInformation measurement_information(const Linearized& lin) const;
   void gate(std::vector<Linearized>& observations, std::vector<LandmarkId>& rejected) const;
   std::optional<NewLandmark> new_landmark(const ObservationType& observation, std::vector<LandmarkId>& unusable) const;
+  /// The linear factor `info`, linearized at the current mean, added to the information form.
   void add(const MeasurementInformation& info);
+  /// The linear factor `info` taken out again, the mean having moved since it was linearized.
+  void take_out(const MeasurementInformation& info);
+  void add_factor(const MeasurementInformation& info, double sign, const Eigen::Matrix<double, X, 1>& r_x,
+                  const Eigen::Matrix<double, M, 1>& r_m);
+  /// The iterated update (SeifOptions::iterations): `step` relinearized at the recovered mean, the mean
+  /// recovered again by `recover`, until the mean stops moving; returns the last recovery's pivots.
+  template <class Recover>
+  std::optional<Eigen::VectorXd> relinearize_at_iterates(std::span<const ObservationType> known,
+                                                         std::vector<MeasurementInformation>& step, Recover recover,
+                                                         std::optional<Eigen::VectorXd> squared_pivots,
+                                                         const State& prior);
+  /// `step` linearized again at the current mean; nothing when an observation cannot be used there.
+  std::optional<std::vector<MeasurementInformation>> relinearize(std::span<const ObservationType> known,
+                                                                 const std::vector<MeasurementInformation>& step) const;
+  /// The mean after this step's measurements: exact when due, else over the active block.
+  std::optional<Eigen::VectorXd> recover_step_mean();
+  /// ESEIF, iterated: the whole step (the held-back measurements too) iterated to its mean, then the
+  /// held-back ones, linearized there, taken out again for relocalize().
+  void iterate_before_relocalizing(std::span<const ObservationType> known,
+                                   const std::vector<MeasurementInformation>& applied,
+                                   std::vector<MeasurementInformation>& held_back, std::vector<std::size_t> observed);
   void augment(const NewLandmark& landmark);
+  std::vector<std::size_t> add_step(const std::vector<MeasurementInformation>& measurements,
+                                    const std::vector<NewLandmark>& landmarks);
   /// What a failed step restores besides the information form (which journals itself).
   struct Undo {
     State x;

@@ -101,12 +101,9 @@ template <class Motion, class Sensor>
 auto EkfSlam<Motion, Sensor>::linearize_at(const ObservationType& observation, std::size_t slot, const State& x,
                                            const Landmark& m, std::vector<LandmarkId>& unusable) const
     -> std::optional<Linearized> {
-  auto lin = linearize_if_observable(sensor_, x, m, observation.z, observation.landmark_id, offset_of(slot), unusable);
-  if (!lin) return lin;
-  const Landmark first(landmarks_.first_mean(slot));
-  if (options_.first_estimate_jacobians) use_first_estimate_jacobians(sensor_, x, first, observation.z, *lin);
-  constrain_observation_if<Space>(options_.observability_constraints, *lin, propagated_, first);
-  return lin;
+  return linearize_for_filter<Space>(sensor_, x, m, Landmark(landmarks_.first_mean(slot)), observation, offset_of(slot),
+                                     propagated_, {options_.first_estimate_jacobians, options_.observability_constraints},
+                                     unusable);
 }
 
 /// Iterated EKF: x_{i+1} = x_0 + P H_i^T S_i^-1 (z - h(x_i) + H_i (x_i - x_0)), the Gauss-Newton step

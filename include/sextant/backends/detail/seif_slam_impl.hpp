@@ -30,6 +30,8 @@ SeifSlam<Motion, Sensor>::SeifSlam(Motion motion, Sensor sensor, const PoseEstim
     throw invalid_input_error("SeifOptions: relocalization_min_information must be finite and >= 0");
   if (options_.mean_recovery_sweeps < 0 || options_.exact_recovery_period < 0)
     throw invalid_input_error("SeifOptions: mean_recovery_sweeps and exact_recovery_period must be >= 0");
+  if (options_.iterations < 1)
+    throw invalid_input_error("SeifOptions: iterations must be >= 1 (1 = one linearization, the thesis's SEIF)");
   gate_ = InnovationGate(Z, options_.gate_probability);
   if (options_.sparsification == SeifSparsification::relocalization) tail_information_ = relocalized_tail_information(prior);
 }
@@ -120,14 +122,9 @@ template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::linearize(const ObservationType& observation, std::vector<LandmarkId>& unusable) const
     -> std::optional<Linearized> {
   const std::size_t slot = landmarks_.slot(observation.landmark_id);
-  auto lin = linearize_if_observable(sensor_, x_, landmark_mean(slot), observation.z, observation.landmark_id,
-                                     offset_of(slot), unusable);
-  if (lin && options_.first_estimate_jacobians)
-    use_first_estimate_jacobians(sensor_, x_, Landmark(landmarks_.first_mean(slot)), observation.z, *lin);
-  if (lin)
-    constrain_observation_if<Space>(options_.observability_constraints, *lin, propagated_,
-                                    Landmark(landmarks_.first_mean(slot)));
-  return lin;
+  return linearize_for_filter<Space>(sensor_, x_, landmark_mean(slot), Landmark(landmarks_.first_mean(slot)),
+                                     observation, offset_of(slot), propagated_,
+                                     {options_.first_estimate_jacobians, options_.observability_constraints}, unusable);
 }
 
 /// H^T Q^-1 H and H^T Q^-1 nu of one observation, by blocks (thesis eqs. 29-30).
@@ -135,7 +132,8 @@ template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::measurement_information(const Linearized& lin) const -> MeasurementInformation {
   const GaussianNoise<Z> noise(lin.Q, "measurement noise Q of landmark " + std::to_string(lin.id));
   const auto info = noise.information(lin.J_z_x, lin.J_z_m, lin.residual);
-  return {landmarks_.slot(lin.id), symmetrized(info.aa), info.ab, symmetrized(info.bb), info.a, info.b};
+  const std::size_t slot = landmarks_.slot(lin.id);
+  return {slot, symmetrized(info.aa), info.ab, symmetrized(info.bb), info.a, info.b, lin.id, x_, landmark_mean(slot)};
 }
 
 /// A new landmark in information form: the conditional m = init.m + J_m_x dx + v, v ~ N(0, C),
@@ -156,11 +154,27 @@ auto SeifSlam<Motion, Sensor>::new_landmark(const ObservationType& observation, 
 
 template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::add(const MeasurementInformation& info) {
-  info_.robot() += info.xx;
-  info_.add_to_robot_link(info.slot, info.xm);
-  info_.diagonal(info.slot) += info.mm;
-  info_.robot_residual() += info.r_x;
-  info_.landmark_residual(info.slot) += info.r_m;
+  add_factor(info, 1.0, info.r_x, info.r_m);
+}
+
+/// The factor's gradient at the current mean is r - Omega_f delta, delta the move from where it was
+/// linearized; that is what the factor contributes to the residual now, and what leaves with it.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::take_out(const MeasurementInformation& info) {
+  const Eigen::Matrix<double, X, 1> dx = Space::minus(x_, info.at_x);
+  const Eigen::Matrix<double, M, 1> dm = landmark_mean(info.slot) - info.at_m;
+  add_factor(info, -1.0, info.r_x - info.xx * dx - info.xm * dm, info.r_m - info.xm.transpose() * dx - info.mm * dm);
+}
+
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::add_factor(const MeasurementInformation& info, double sign,
+                                          const Eigen::Matrix<double, X, 1>& r_x,
+                                          const Eigen::Matrix<double, M, 1>& r_m) {
+  info_.robot() += sign * info.xx;
+  info_.add_to_robot_link(info.slot, sign * info.xm);
+  info_.diagonal(info.slot) += sign * info.mm;
+  info_.robot_residual() += sign * r_x;
+  info_.landmark_residual(info.slot) += sign * r_m;
 }
 
 template <class Motion, class Sensor>
@@ -172,6 +186,22 @@ void SeifSlam<Motion, Sensor>::augment(const NewLandmark& landmark) {
   info_.diagonal(slot) = landmark.mm;
 }
 
+/// The step's measurements and new landmarks added (thesis eqs. 27-30); their slots, in that order.
+template <class Motion, class Sensor>
+std::vector<std::size_t> SeifSlam<Motion, Sensor>::add_step(const std::vector<MeasurementInformation>& measurements,
+                                                            const std::vector<NewLandmark>& landmarks) {
+  std::vector<std::size_t> observed;
+  for (const auto& info : measurements) {
+    add(info);
+    observed.push_back(info.slot);
+  }
+  for (const auto& landmark : landmarks) {
+    augment(landmark);
+    observed.push_back(landmarks_.size() - 1);
+  }
+  return observed;
+}
+
 template <class Motion, class Sensor>
 UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
   using Clock = std::chrono::steady_clock;
@@ -179,7 +209,9 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
   auto stage_start = Clock::now();
   SeifUpdateTimes times;
   require_valid_observations(observations);
-  const auto [known, fresh] = split_known_and_new(landmarks_.pool(), observations);
+  const auto split = split_known_and_new(landmarks_.pool(), observations);
+  const auto& known = split.known;  // a reference, not a structured binding: the transaction's lambda uses it
+  const auto& fresh = split.fresh;
   // Linearize everything first; the rest runs as one transaction, undone if any step throws.
   std::vector<Linearized> linearized;
   linearized.reserve(known.size());
@@ -196,32 +228,25 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
   for (const auto& observation : fresh)
     if (auto landmark = new_landmark(observation, result.unusable)) landmarks.push_back(std::move(*landmark));
   result.initialized = landmarks.size();
-  const auto relocalization = hold_back_for_relocalization(measurements, fresh.size());
+  auto relocalization = hold_back_for_relocalization(measurements, fresh.size());
 
   atomically([&] {
-    std::vector<std::size_t> observed;
-    for (const auto& info : measurements) {
-      add(info);
-      observed.push_back(info.slot);
-    }
-    for (const auto& landmark : landmarks) {
-      augment(landmark);
-      observed.push_back(landmarks_.size() - 1);
-    }
+    const State prior = x_;
+    std::vector<std::size_t> observed = add_step(measurements, landmarks);
     times.measurement_s = seconds_since(stage_start);
     stage_start = Clock::now();
     ++updates_;
     if (!relocalization.empty()) {
+      if (options_.iterations > 1) iterate_before_relocalizing(known, measurements, relocalization, observed);
       relocalize(relocalization, std::move(observed));
       times.mean_recovery_s = seconds_since(stage_start);
       return;
     }
     update_active_queue(observed);  // first: mean recovery orders the active block by it
-    std::optional<Eigen::VectorXd> squared_pivots;
-    if (exact_recovery_due())
-      recover_mean_exactly_in_transaction();
-    else
-      squared_pivots = recover_mean_locally();
+    auto squared_pivots = recover_step_mean();
+    if (options_.iterations > 1)
+      squared_pivots = relinearize_at_iterates(known, measurements, [&] { return recover_step_mean(); },
+                                               std::move(squared_pivots), prior);
     times.mean_recovery_s = seconds_since(stage_start);
     stage_start = Clock::now();
     const auto robot_squared_pivots = sparsify(squared_pivots.has_value());
@@ -231,6 +256,76 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
   last_update_times_ = times;
   if (!relocalization.empty()) ++relocalizations_;
   return result;
+}
+
+template <class Motion, class Sensor>
+std::optional<Eigen::VectorXd> SeifSlam<Motion, Sensor>::recover_step_mean() {
+  if (!exact_recovery_due()) return recover_mean_locally();
+  recover_mean_exactly_in_transaction();
+  return std::nullopt;
+}
+
+/// The iterated SEIF update: Gauss-Newton on the prior and the step's measurements, as the iterated
+/// EKF (Bell and Cathey 1993), in information form. Each iterate takes the step's factors out at the
+/// recovered mean (their gradient moved there), adds them again linearized there, and recovers the
+/// mean; stops when it moves by < 1e-9 of the step's move, or where an observation cannot be used.
+template <class Motion, class Sensor>
+template <class Recover>
+std::optional<Eigen::VectorXd> SeifSlam<Motion, Sensor>::relinearize_at_iterates(
+    std::span<const ObservationType> known, std::vector<MeasurementInformation>& step, Recover recover,
+    std::optional<Eigen::VectorXd> squared_pivots, const State& prior) {
+  for (int i = 1; i < options_.iterations; ++i) {
+    auto relinearized = relinearize(known, step);
+    if (!relinearized) break;
+    for (const auto& info : step) take_out(info);
+    for (const auto& info : *relinearized) add(info);
+    step = std::move(*relinearized);
+    squared_pivots = recover();
+    double moved = 0.0;  // since the linearization, robot and the step's landmarks
+    for (const auto& info : step)
+      moved = std::max({moved, Space::minus(x_, info.at_x).template lpNorm<Eigen::Infinity>(),
+                        (landmark_mean(info.slot) - info.at_m).template lpNorm<Eigen::Infinity>()});
+    if (moved <= 1e-9 * (1.0 + Space::minus(x_, prior).template lpNorm<Eigen::Infinity>())) break;
+  }
+  return squared_pivots;
+}
+
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::relinearize(std::span<const ObservationType> known,
+                                           const std::vector<MeasurementInformation>& step) const
+    -> std::optional<std::vector<MeasurementInformation>> {
+  std::vector<MeasurementInformation> out;
+  out.reserve(step.size());
+  std::vector<LandmarkId> unusable;
+  for (const auto& info : step) {
+    const auto observation = std::find_if(known.begin(), known.end(),
+                                          [&](const ObservationType& o) { return o.landmark_id == info.id; });
+    auto lin = linearize(*observation, unusable);
+    if (!lin) return std::nullopt;
+    out.push_back(measurement_information(*lin));
+  }
+  return out;
+}
+
+/// The held-back measurements join the others, the step is iterated to its mean over the robot and
+/// every landmark linked to it, and they leave again linearized there: ESEIF then relocalizes the
+/// robot from measurements linearized at the step's mean instead of at the prediction.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::iterate_before_relocalizing(std::span<const ObservationType> known,
+                                                           const std::vector<MeasurementInformation>& applied,
+                                                           std::vector<MeasurementInformation>& held_back,
+                                                           std::vector<std::size_t> observed) {
+  const State prior = x_;
+  std::vector<MeasurementInformation> step = applied;
+  for (const auto& info : held_back) {
+    add(info);
+    observed.push_back(info.slot);
+  }
+  step.insert(step.end(), held_back.begin(), held_back.end());
+  update_active_queue(observed);
+  relinearize_at_iterates(known, step, [&] { return recover_step_mean(); }, recover_step_mean(), prior);
+  held_back.assign(step.end() - static_cast<std::ptrdiff_t>(held_back.size()), step.end());
+  for (const auto& info : held_back) take_out(info);
 }
 
 /// Removes the observations whose innovation fails the chi-square test, with S = H Sigma H^T + Q and
