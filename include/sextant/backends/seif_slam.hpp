@@ -239,13 +239,10 @@ class SeifSlam {
   void take_out(const MeasurementInformation& info);
   void add_factor(const MeasurementInformation& info, double sign, const Eigen::Matrix<double, X, 1>& r_x,
                   const Eigen::Matrix<double, M, 1>& r_m);
-  /// The iterated update (SeifOptions::iterations): `step` relinearized at the recovered mean, the mean
-  /// recovered again by `recover`, until the mean stops moving; returns the last recovery's pivots.
-  template <class Recover>
-  std::optional<Eigen::VectorXd> relinearize_at_iterates(std::span<const ObservationType> known,
-                                                         std::vector<MeasurementInformation>& step, Recover recover,
-                                                         std::optional<Eigen::VectorXd> squared_pivots,
-                                                         const State& prior);
+  /// The iterated update (SeifOptions::iterations): `step` relinearized at the recovered mean and the
+  /// mean recovered again, until it stops moving; `squared_pivots` keeps the last recovery's.
+  void relinearize_at_iterates(std::span<const ObservationType> known, std::vector<MeasurementInformation>& step,
+                               const State& prior, std::optional<Eigen::VectorXd>& squared_pivots);
   /// `step` linearized again at the current mean; nothing when an observation cannot be used there.
   std::optional<std::vector<MeasurementInformation>> relinearize(std::span<const ObservationType> known,
                                                                  const std::vector<MeasurementInformation>& step) const;
@@ -255,7 +252,8 @@ class SeifSlam {
   /// held-back ones, linearized there, taken out again for relocalize().
   void iterate_before_relocalizing(std::span<const ObservationType> known,
                                    const std::vector<MeasurementInformation>& applied,
-                                   std::vector<MeasurementInformation>& held_back, std::vector<std::size_t> observed);
+                                   std::vector<MeasurementInformation>& held_back, std::vector<std::size_t> observed,
+                                   const State& prior);
   void augment(const NewLandmark& landmark);
   std::vector<std::size_t> add_step(const std::vector<MeasurementInformation>& measurements,
                                     const std::vector<NewLandmark>& landmarks);

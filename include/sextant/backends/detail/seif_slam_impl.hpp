@@ -237,16 +237,14 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
     stage_start = Clock::now();
     ++updates_;
     if (!relocalization.empty()) {
-      if (options_.iterations > 1) iterate_before_relocalizing(known, measurements, relocalization, observed);
+      if (options_.iterations > 1) iterate_before_relocalizing(known, measurements, relocalization, observed, prior);
       relocalize(relocalization, std::move(observed));
       times.mean_recovery_s = seconds_since(stage_start);
       return;
     }
     update_active_queue(observed);  // first: mean recovery orders the active block by it
     auto squared_pivots = recover_step_mean();
-    if (options_.iterations > 1)
-      squared_pivots = relinearize_at_iterates(known, measurements, [&] { return recover_step_mean(); },
-                                               std::move(squared_pivots), prior);
+    if (options_.iterations > 1) relinearize_at_iterates(known, measurements, prior, squared_pivots);
     times.mean_recovery_s = seconds_since(stage_start);
     stage_start = Clock::now();
     const auto robot_squared_pivots = sparsify(squared_pivots.has_value());
@@ -270,24 +268,22 @@ std::optional<Eigen::VectorXd> SeifSlam<Motion, Sensor>::recover_step_mean() {
 /// recovered mean (their gradient moved there), adds them again linearized there, and recovers the
 /// mean; stops when it moves by < 1e-9 of the step's move, or where an observation cannot be used.
 template <class Motion, class Sensor>
-template <class Recover>
-std::optional<Eigen::VectorXd> SeifSlam<Motion, Sensor>::relinearize_at_iterates(
-    std::span<const ObservationType> known, std::vector<MeasurementInformation>& step, Recover recover,
-    std::optional<Eigen::VectorXd> squared_pivots, const State& prior) {
+void SeifSlam<Motion, Sensor>::relinearize_at_iterates(std::span<const ObservationType> known,
+                                                       std::vector<MeasurementInformation>& step, const State& prior,
+                                                       std::optional<Eigen::VectorXd>& squared_pivots) {
   for (int i = 1; i < options_.iterations; ++i) {
     auto relinearized = relinearize(known, step);
     if (!relinearized) break;
     for (const auto& info : step) take_out(info);
     for (const auto& info : *relinearized) add(info);
     step = std::move(*relinearized);
-    squared_pivots = recover();
+    squared_pivots = recover_step_mean();
     double moved = 0.0;  // since the linearization, robot and the step's landmarks
     for (const auto& info : step)
       moved = std::max({moved, Space::minus(x_, info.at_x).template lpNorm<Eigen::Infinity>(),
                         (landmark_mean(info.slot) - info.at_m).template lpNorm<Eigen::Infinity>()});
     if (moved <= 1e-9 * (1.0 + Space::minus(x_, prior).template lpNorm<Eigen::Infinity>())) break;
   }
-  return squared_pivots;
 }
 
 template <class Motion, class Sensor>
@@ -314,8 +310,7 @@ template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::iterate_before_relocalizing(std::span<const ObservationType> known,
                                                            const std::vector<MeasurementInformation>& applied,
                                                            std::vector<MeasurementInformation>& held_back,
-                                                           std::vector<std::size_t> observed) {
-  const State prior = x_;
+                                                           std::vector<std::size_t> observed, const State& prior) {
   std::vector<MeasurementInformation> step = applied;
   for (const auto& info : held_back) {
     add(info);
@@ -323,7 +318,8 @@ void SeifSlam<Motion, Sensor>::iterate_before_relocalizing(std::span<const Obser
   }
   step.insert(step.end(), held_back.begin(), held_back.end());
   update_active_queue(observed);
-  relinearize_at_iterates(known, step, [&] { return recover_step_mean(); }, recover_step_mean(), prior);
+  auto squared_pivots = recover_step_mean();  // relocalize() recovers again; these are not needed
+  relinearize_at_iterates(known, step, prior, squared_pivots);
   held_back.assign(step.end() - static_cast<std::ptrdiff_t>(held_back.size()), step.end());
   for (const auto& info : held_back) take_out(info);
 }
