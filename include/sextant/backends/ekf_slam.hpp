@@ -107,6 +107,13 @@ class EkfSlam {
   /// Marginalizes a landmark out of the joint Gaussian. Throws unknown_landmark_error.
   void remove_landmark(LandmarkId id);
 
+  /// Puts a landmark known before it is seen (a surveyed beacon, a map from an earlier run) into the
+  /// map with the given mean and covariance, uncorrelated with the robot and the other landmarks;
+  /// its first estimate (first-estimate Jacobians) is that mean. Throws duplicate_landmark_error for
+  /// an id in the map, invalid_input_error for a mean or covariance with NaN or Inf or a covariance
+  /// that is not symmetric positive definite; the state is then unchanged.
+  void add_landmark(const LandmarkEstimate<M>& known);
+
   /// Moves the robot's mean by d (Space::plus) and adds d d^T to its covariance: the pose taken
   /// as lost by d, with the uncertainty of not knowing whether it was (core/pose_reacquisition.hpp).
   /// Throws invalid_input_error on a d that is not finite; the state is then unchanged.
