@@ -263,6 +263,38 @@ TEST(FastSlam, OnALinearWorldTheParticleCloudIsTheKalmanFilterWithinSamplingErro
   }
 }
 
+/// pose() is the weighted mixture of the particles' Gaussians (FastSLAM 2.0: the proposals they were
+/// drawn from) plus the frame's uncertainty: checked against the mixture's moments computed here the
+/// other way round, from raw second moments, sum w (C + mu mu^T) - mean mean^T, five particles that
+/// never resample. The frame's uncertainty is the prior's, one step of dead reckoning before the first
+/// landmark.
+TEST(FastSlam, ThePoseIsTheWeightedMixtureOfTheParticlesProposals) {
+  const auto data = sim::simulate_ship_2d({.seed = 6, .num_steps = 40});
+  ASSERT_FALSE(data.steps.front().observations.empty());
+  const Fast::PoseEstimate prior{data.prior.mean, 1e-12 * Eigen::Matrix2d::Identity()};
+  Fast fast{data.motion, data.sensor, prior, {.particles = 5, .resample_threshold = 0.0}};
+  const auto first = data.motion.predict(data.prior.mean, data.steps.front().control, data.steps.front().dt);
+  const Eigen::Matrix2d frame = first.J_x_x * prior.cov * first.J_x_x.transpose() + first.R;
+  for (const auto& step : data.steps) {
+    fast.predict(step.control, step.dt);
+    fast.update(step.observations);
+  }
+  const auto w = fast.weights();
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d second = Eigen::Matrix2d::Zero(), within = Eigen::Matrix2d::Zero();
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    const auto& p = fast.particles()[i];
+    mean += w[i] * p.drawn_from;
+    second += w[i] * (p.drawn_cov + p.drawn_from * p.drawn_from.transpose());
+    within += w[i] * p.drawn_cov;
+  }
+  const Eigen::Matrix2d cov = second - mean * mean.transpose() + frame;
+  const auto pose = fast.pose();
+  EXPECT_LT((pose.mean - mean).norm(), 1e-9 * mean.norm());
+  EXPECT_LT((pose.cov - cov).norm(), 1e-7 * cov.norm());
+  EXPECT_GT((pose.cov - within - frame).determinant(), 0.0);  // the particles' spread counts too
+}
+
 /// The weights stay normalized, N_eff is 1 / sum w^2 of them, and the low-variance sampler (§3.7.4)
 /// copies each particle floor(N w) or ceil(N w) times. Two filters with one seed see the same steps:
 /// one never resamples, the other as soon as N_eff falls below 0.999 N; up to that step they draw
