@@ -22,6 +22,7 @@
 #include "mrpt/mrpt_demo_data.hpp"
 #include "sextant/mrpt/scene.hpp"
 #include "support/run_program.hpp"
+#include "support/shared_data.hpp"
 
 namespace {
 
@@ -169,6 +170,25 @@ TEST_F(RunnerCli, MrclamAndIsamRunInTheirOwnPrograms) {
     EXPECT_NE(r.exit_code, 0);
     EXPECT_NE(r.err.find(std::string(program) + " runs"), std::string::npos) << r.err;
   }
+}
+
+/// An MRCLAM run prints, below each robot's table, the EKF given the surveyed map: the same filter
+/// with every landmark known before it is seen, which has more to go on than EKF-SLAM and so must not
+/// end further from Vicon after alignment (the peer is the EKF row of the same run).
+TEST_F(RunnerCli, MrclamPrintsTheFilterGivenTheSurveyedMap) {
+  const std::string data = sextant::test::shared_data("mrclam/MRCLAM_Dataset6");
+  SEXTANT_REQUIRE_DATA(data);
+  const auto r = run_runner("-d mrclam:" + data + ":1 -b ekf", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto given = r.out.find("the EKF given the surveyed map");
+  ASSERT_NE(given, std::string::npos) << r.out;
+  double given_rmse = 0.0, given_aligned = 0.0, ekf_rmse = 0.0, ekf_aligned = 0.0;
+  ASSERT_EQ(std::sscanf(r.out.c_str() + r.out.find("position RMSE", given), "position RMSE %lf m (aligned %lf)", &given_rmse,
+                        &given_aligned), 2) << r.out;
+  ASSERT_EQ(std::sscanf(r.out.c_str() + r.out.find(", ekf ", given), ", ekf %lf (%lf)", &ekf_rmse, &ekf_aligned), 2) << r.out;
+  EXPECT_GT(given_aligned, 0.0);
+  EXPECT_LT(given_aligned, ekf_aligned);
+  EXPECT_LT(given_rmse, ekf_rmse);
 }
 
 TEST_F(RunnerCli, SpatialRunDrawsLandmarkEllipsoids) {
