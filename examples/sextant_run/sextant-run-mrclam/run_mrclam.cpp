@@ -59,34 +59,14 @@ DeadReckoningScore score_dead_reckoning(const io::MrclamRun& data) {
 /// with a 1 mm standard deviation before the first step (EkfSlam::add_landmark), otherwise as the
 /// row. A filter estimates each pose from the past alone, so one that must also build the map has
 /// less to go on than this; a smoother (GraphSLAM) uses the sightings after a pose too.
-struct SurveyedMapScore {
-  double rmse = 0.0, aligned_rmse = 0.0;
-  std::size_t failed_updates = 0;
-};
-
 template <class Dataset>
-SurveyedMapScore score_filter_given_map(const Dataset& data, const RunnerConfig& config) {
+eval::RunScores score_filter_given_map(const Dataset& data, const RunnerConfig& config) {
+  constexpr Scoring scoring = scoring_of<Dataset>();
   const auto choice = backend_choices<typename Dataset::Motion>({BackendKind::ekf}, config).front();
   EkfSlam<typename Dataset::Motion, typename Dataset::Sensor> ekf(data.motion, data.sensor, data.prior, choice.ekf);
   for (const auto& [id, m] : data.true_landmarks) ekf.add_landmark({id, m, 1e-6 * Eigen::Matrix2d::Identity()});
-  SurveyedMapScore out;
-  std::vector<Eigen::Vector2d> positions, true_positions;
-  double sum = 0.0;
-  for (std::size_t k = 0; k < data.steps.size(); ++k) {
-    ekf.predict(data.steps[k].control, data.steps[k].dt);
-    try {
-      ekf.update(data.steps[k].observations);
-    } catch (const error&) {
-      ++out.failed_updates;
-    }
-    positions.push_back(ekf.pose().mean.template head<2>());
-    true_positions.push_back(data.true_poses[k + 1].template head<2>());
-    sum += (positions.back() - true_positions.back()).squaredNorm();
-  }
-  if (positions.empty()) return out;
-  out.rmse = std::sqrt(sum / static_cast<double>(positions.size()));
-  out.aligned_rmse = eval::rms(eval::aligned_errors<2>(positions, true_positions));
-  return out;
+  const auto run = eval::evaluate_run(ekf, data, scoring.position_dim, eval::NoStepCallback{}, eval::StepErrors::skip);
+  return eval::scores_of(run, scoring.pose_dof, scoring.landmark_dof);
 }
 
 /// The run with the pose perturbed in the world frame (models/se2_world_frame.hpp): the same data,
@@ -164,10 +144,10 @@ std::vector<TableRow> run_mrclam(const CliOptions& cli, const std::string& datas
     const auto given_map = config.mrclam_filters_in_world_frame ? score_filter_given_map(in_world_frame(data), config)
                                                                  : score_filter_given_map(data, config);
     const std::string failed =
-        given_map.failed_updates ? ", " + std::to_string(given_map.failed_updates) + " failed updates" : std::string();
+        given_map.failed_steps ? ", " + std::to_string(given_map.failed_steps) + " failed steps" : std::string();
     std::printf("the EKF given the surveyed map (each landmark known to 1 mm, otherwise as its row): position RMSE %.3f m "
                 "(aligned %.3f)%s; a filter that must also map has less to go on\n",
-                given_map.rmse, given_map.aligned_rmse, failed.c_str());
+                given_map.pose_rmse, given_map.pose_rmse_aligned, failed.c_str());
     std::printf("position RMSE against Vicon [m] (after rigid alignment): dead reckoning %.3f (%.3f)", drift.rmse,
                 drift.aligned_rmse);
     for (const auto& row : part)
