@@ -2,6 +2,7 @@
 /// \file Input checks shared by the back-ends. Each throws a sextant error that names the problem;
 /// back-ends call them before touching their state.
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <cmath>
@@ -27,6 +28,17 @@ void require_finite(const T& value, const std::string& what) {
 inline void require_positive_time_step(double dt) {
   if (!std::isfinite(dt) || dt <= 0.0)
     throw invalid_input_error("time step dt must be finite and > 0, got " + std::to_string(dt));
+}
+
+/// Throws invalid_input_error unless a matrix the caller was given (a covariance, an information) is
+/// finite, symmetric (to 1e-9 of its largest entry) and positive definite; `what` names it.
+template <int N>
+void require_symmetric_positive_definite(const Eigen::Matrix<double, N, N>& a, const std::string& what) {
+  if (!a.allFinite()) throw invalid_input_error(what + " contains NaN or Inf");
+  const double scale = a.cwiseAbs().maxCoeff();
+  if (!((a - a.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale)) throw invalid_input_error(what + " is not symmetric");
+  if (Eigen::LLT<Eigen::Matrix<double, N, N>>(a).info() != Eigen::Success || !(scale > 0.0))
+    throw invalid_input_error(what + " is not positive definite");
 }
 
 /// Throws numerical_error unless the process noise R of a motion step is finite, symmetric and

@@ -337,11 +337,7 @@ template <class Motion, class Sensor>
 void EkfSlam<Motion, Sensor>::add_landmark(const LandmarkEstimate<M>& known) {
   const std::string what = "known landmark " + std::to_string(known.id);
   require_finite(known.mean, what + " mean");
-  require_finite(known.cov, what + " covariance");
-  if (!((known.cov - known.cov.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * known.cov.cwiseAbs().maxCoeff()))
-    throw invalid_input_error(what + ": covariance is not symmetric");
-  if (Eigen::LLT<Eigen::Matrix<double, M, M>>(known.cov).info() != Eigen::Success)
-    throw invalid_input_error(what + ": covariance is not positive definite");
+  require_symmetric_positive_definite<M>(known.cov, what + " covariance");
   if (landmarks_.contains(known.id)) throw duplicate_landmark_error("landmark id " + std::to_string(known.id) + " is already in the map");
   if (probation_.active()) probation_.candidate().add_landmark(known);  // checked above: cannot throw but bad_alloc
   const Eigen::Index offset = cov_.dim();

@@ -15,22 +15,6 @@
 
 namespace sextant {
 
-namespace detail {
-
-/// Throws invalid_input_error unless `information` is finite, symmetric (to 1e-9 relative) and
-/// positive definite.
-template <int N>
-void require_information(const Eigen::Matrix<double, N, N>& information, const std::string& what) {
-  if (!information.allFinite()) throw invalid_input_error(what + ": information matrix contains NaN or Inf");
-  const double scale = information.cwiseAbs().maxCoeff();
-  if (!((information - information.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale))
-    throw invalid_input_error(what + ": information matrix is not symmetric");
-  if (Eigen::LLT<Eigen::Matrix<double, N, N>>(information).info() != Eigen::Success || !(scale > 0.0))
-    throw invalid_input_error(what + ": information matrix is not positive definite");
-}
-
-}  // namespace detail
-
 template <class Poses>
 void PoseGraph<Poses>::require_new_id(VertexId id) const {
   if (index_.contains(id)) throw invalid_input_error("vertex " + std::to_string(id) + " is defined twice");
@@ -87,7 +71,7 @@ void PoseGraph<Poses>::add_between(VertexId from, VertexId to, const Pose& z, co
   const std::size_t a = slot_of(from, false), b = slot_of(to, false);
   if (a == b) throw invalid_input_error(what + ": joins a pose to itself");
   if (!Poses::is_finite(z)) throw invalid_input_error(what + ": measurement contains NaN or Inf");
-  detail::require_information<E>(information, what);
+  require_symmetric_positive_definite<E>(information, what + ": information matrix");
   const EdgeClass edge_class = (to == from + 1 || from == to + 1) ? EdgeClass::odometry : EdgeClass::loop_closure;
   betweens_.push_back({a, b, z, symmetrized(information), edge_class, false});
 }
@@ -97,7 +81,7 @@ void PoseGraph<Poses>::add_pose_prior(VertexId pose, const Pose& z, const EdgeIn
   const std::string what = "prior on pose " + std::to_string(pose);
   const std::size_t a = slot_of(pose, false);
   if (!Poses::is_finite(z)) throw invalid_input_error(what + ": measurement contains NaN or Inf");
-  detail::require_information<E>(information, what);
+  require_symmetric_positive_definite<E>(information, what + ": information matrix");
   priors_.push_back({a, z, symmetrized(information)});
 }
 
@@ -107,7 +91,7 @@ void PoseGraph<Poses>::add_point_observation(VertexId pose, VertexId point, cons
   const std::string what = "observation of point " + std::to_string(point) + " from pose " + std::to_string(pose);
   const std::size_t a = slot_of(pose, false), b = slot_of(point, true);
   if (!z.allFinite() || !Poses::is_finite(offset)) throw invalid_input_error(what + ": measurement contains NaN or Inf");
-  detail::require_information<P>(information, what);
+  require_symmetric_positive_definite<P>(information, what + ": information matrix");
   observations_.push_back({a, b, z, symmetrized(information), offset});
 }
 
