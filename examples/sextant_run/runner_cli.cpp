@@ -79,7 +79,8 @@ RunnerConfig load_runner_config(CliOptions& options) {
 void finish_run(const CliOptions& options, const std::vector<TableRow>& rows) {
   std::printf("\naligned: the same error after the best rigid alignment of the trajectory (map) to the truth; "
               "NEES in: share of steps (pose) or landmarks (map) whose NEES is inside the 95%% chi-square bound; "
-              "pose ANEES: mean NEES over steps and runs (pose dof: ship 2, planar 3, 6D 6).\n");
+              "pose ANEES: mean NEES over steps and runs (pose dof: ship 2, planar 3, 6D 6), or 'collapsed' where a "
+              "particle cloud's pose rested on fewer than dof + 1 effective particles.\n");
   if (options.output.out.empty()) return;
   std::filesystem::create_directories(options.output.out);
   const auto json = (std::filesystem::path(options.output.out) / "summary.json").string();

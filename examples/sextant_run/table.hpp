@@ -74,6 +74,12 @@ inline void print_relocalization(int indent, const RelocalizationRow& r) {
               r.active > r.max_active ? " when a held-back set carries enough information" : "");
 }
 
+/// The pose ANEES, or "collapsed" where some steps' covariance rests on too few particles to be one
+/// (eval::RunScores::pose_undersampled): a particle cloud's NEES there is 1e5-1e8, the sample's size.
+inline std::string anees_cell(const eval::Summary& s) {
+  return s.pose_undersampled > 0.0 ? std::string("collapsed") : cell("%.4g", s.pose_anees);
+}
+
 inline void print_row(const TableRow& row) {
   if (row.failure) {
     std::printf("%-29s failed: %s\n", row.label.c_str(), row.failure->c_str());
@@ -83,13 +89,16 @@ inline void print_row(const TableRow& row) {
   std::printf("%-29s %10s %10s %10s %10s %13s %12s %11s %10.4f %13.1f\n", row.label.c_str(), cell("%.4g", s.pose_mae).c_str(),
               cell("%.4g", s.pose_mae_aligned).c_str(), cell("%.4g", s.map_mae).c_str(), cell("%.4g", s.map_mae_aligned).c_str(),
               cell("%.1f%%", 100.0 * s.pose_nees_inside).c_str(), cell("%.1f%%", 100.0 * s.map_nees_inside).c_str(),
-              cell("%.4g", s.pose_anees).c_str(), s.total_seconds, 1e6 * s.seconds_per_step);
+              anees_cell(s).c_str(), s.total_seconds, 1e6 * s.seconds_per_step);
   if (const auto& a = row.association)
     std::printf("%-29s association: precision %.4f, recall %.4f; %zu wrong pairings, %zu duplicate landmarks, %zu "
                 "discarded\n", "", a->precision, a->recall, a->wrong, a->duplicates, a->discarded);
   if (const auto& cloud = row.cloud)
     std::printf("%-29s the cloud at the end: N_eff %.3g of %.0f; all descend from %.0f of the %.0f it started with\n", "",
                 cloud->effective_sample_size, cloud->particles, cloud->distinct_ancestors, cloud->particles);
+  if (s.pose_undersampled > 0.0)
+    std::printf("%-29s collapsed: at %.1f%% of the steps the pose rests on fewer than dof + 1 effective particles, "
+                "its NEES there the sample's\n", "", 100.0 * s.pose_undersampled);
   if (const auto& r = row.relocalization) print_relocalization(29, *r);
   print_skipped_steps(29, row.summary.failed_steps, "step", row.summary.first_failure);  // over all its runs
 }
@@ -132,6 +141,7 @@ inline void write_summary_json(const std::string& path, const std::vector<TableR
         << ", \"pose_rmse\": " << json_number(s.pose_rmse) << ", \"pose_rmse_aligned\": " << json_number(s.pose_rmse_aligned)
         << ", \"map_mae_aligned\": " << json_number(s.map_mae_aligned) << ", \"pose_nees_inside\": " << json_number(s.pose_nees_inside)
         << ", \"map_nees_inside\": " << json_number(s.map_nees_inside) << ", \"pose_anees\": " << json_number(s.pose_anees)
+        << ", \"pose_undersampled\": " << json_number(s.pose_undersampled)
         << ", \"total_seconds\": " << json_number(s.total_seconds)
         << ", \"seconds_per_step\": " << json_number(s.seconds_per_step) << ", \"failed_steps\": " << s.failed_steps;
     if (const auto& f = rows[i].failure) out << ", \"failure\": \"" << json_escaped(*f) << "\"";

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
+#include <map>
 #include <set>
 
 #include "sextant/eval/runner.hpp"
@@ -335,6 +337,42 @@ TEST(FastSlam, ResamplingCopiesEachParticleByItsWeightAndNormalizesTheWeights) {
     return;
   }
   FAIL() << "the weights never spread enough to resample";
+}
+
+TEST(FastSlam, VersionOnesPoseRestsOnTheEffectiveNumberOfItsDistinctPoints) {
+  // FastSLAM 1.0 weighs its draws, so pose()'s covariance is the spread of weighted points: it rests
+  // on 1 / sum w^2 of them, copies of one particle counted once with their summed weight. FastSLAM
+  // 2.0's particles each report a Gaussian (their proposals; a predict's motion): no limit (+inf).
+  constexpr double kGaussians = std::numeric_limits<double>::infinity();
+  const auto data = sim::simulate_ship_2d({.seed = 4, .num_steps = 60});
+  constexpr std::size_t N = 64;
+  Fast one{data.motion, data.sensor, data.prior, {.particles = N, .version = FastSlamVersion::v1, .resample_threshold = 0.0}};
+  Fast two{data.motion, data.sensor, data.prior, {.particles = N, .resample_threshold = 0.0}};
+  Fast soon{data.motion, data.sensor, data.prior, {.particles = N, .version = FastSlamVersion::v1, .resample_threshold = 0.999}};
+  for (const auto& step : data.steps) {
+    for (Fast* f : {&one, &two, &soon}) f->predict(step.control, step.dt);
+    EXPECT_EQ(two.pose_sample_support(), kGaussians);
+    const bool mapped = one.num_landmarks() > 0;
+    for (Fast* f : {&one, &two, &soon}) f->update(step.observations);
+    EXPECT_EQ(two.pose_sample_support(), kGaussians);
+    if (!mapped) {  // the particles dead-reckoned together, their spread is the frame's Gaussian
+      EXPECT_EQ(one.pose_sample_support(), kGaussians);
+      continue;
+    }
+    EXPECT_NEAR(one.pose_sample_support(), one.effective_sample_size(), 1e-9 * N);  // no resampling: the weights
+    if (soon.resamplings() > 0) break;
+  }
+  ASSERT_EQ(soon.resamplings(), 1u);
+  soon.update(std::vector<Fast::ObservationType>{});  // nothing seen: pose() is the resampled cloud's, copies
+  std::map<std::pair<double, double>, double> weight_at;
+  const auto w = soon.weights();
+  for (std::size_t i = 0; i < N; ++i) weight_at[{soon.particles()[i].x.x(), soon.particles()[i].x.y()}] += w[i];
+  double sum_sq = 0.0;
+  for (const auto& [point, weight] : weight_at) sum_sq += weight * weight;
+  ASSERT_LT(weight_at.size(), N);
+  ASSERT_EQ(soon.resamplings(), 1u);
+  EXPECT_NEAR(soon.pose_sample_support(), 1.0 / sum_sq, 1e-9 * N);
+  EXPECT_LT(soon.pose_sample_support(), soon.effective_sample_size());
 }
 
 TEST(FastSlam, TracksTheShipAndVersionTwoBeatsVersionOne) {

@@ -51,6 +51,7 @@ RunSummary<Eigen::Vector2d> random_run(std::mt19937_64& rng, std::size_t steps) 
     r.pose_error.push_back(value(rng));
     r.pose_error_aligned.push_back(value(rng));
     r.pose_nees.push_back(value(rng) * 2.0);
+    r.pose_support.push_back(rng() % 3 == 0 ? 2.5 * value(rng) : std::numeric_limits<double>::infinity());
     r.seconds.push_back(1e-4 * value(rng));
   }
   for (int i = 0; i < 7; ++i) {
@@ -87,7 +88,8 @@ void expect_same_summary(const Summary& a, const Summary& b) {
   for (auto field : {&Summary::pose_mae, &Summary::map_mae, &Summary::map_mae_over_time, &Summary::pose_rmse,
                      &Summary::pose_rmse_aligned, &Summary::pose_mae_aligned, &Summary::map_mae_aligned,
                      &Summary::pose_nees_inside, &Summary::map_nees_inside, &Summary::total_seconds,
-                     &Summary::seconds_per_step, &Summary::pose_anees, &Summary::pose_mae_std, &Summary::map_mae_std})
+                     &Summary::seconds_per_step, &Summary::pose_anees, &Summary::pose_mae_std, &Summary::map_mae_std,
+                     &Summary::pose_undersampled})
     expect_same_bits(a.*field, b.*field, "a score");
   ASSERT_EQ(a.anees_interval.has_value(), b.anees_interval.has_value());
   if (a.anees_interval) {
@@ -111,6 +113,21 @@ std::vector<RecordFile> written_and_read(const std::vector<StudyRecord>& all, in
     files.push_back(parse_records(text, record_file_name({i, shards})));
   }
   return files;
+}
+
+TEST(RunScores, AStepWhosePoseRestsOnTooFewParticlesIsUndersampledAndNeverInside) {
+  // 2 dof: a covariance from fewer than 3 effective particles cannot span the pose (bound 5.991).
+  RunSummary<Eigen::Vector2d> r;
+  r.pose_nees = {1.0, 100.0, 2.0, 3.0, 4.0};
+  r.pose_support = {std::numeric_limits<double>::infinity(), 50.0, 2.9, 3.0, 1.0};
+  const auto s = scores_of(r, 2, 2);
+  EXPECT_DOUBLE_EQ(s.pose_undersampled, 2.0 / 5.0);  // steps 2 and 4
+  EXPECT_DOUBLE_EQ(s.pose_nees_inside, 2.0 / 5.0);   // steps 0 and 3: 1 is above the bound
+  EXPECT_DOUBLE_EQ(s.pose_anees, 22.0);              // the raw average, kept for the record
+  r.pose_support.clear();                            // a Gaussian back-end's run
+  const auto gaussian = scores_of(r, 2, 2);
+  EXPECT_EQ(gaussian.pose_undersampled, 0.0);
+  EXPECT_DOUBLE_EQ(gaussian.pose_nees_inside, 4.0 / 5.0);
 }
 
 TEST(StudyRecords, MergedShardsAverageToTheBitLikeTheRunsInOneProcess) {

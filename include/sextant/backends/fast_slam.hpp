@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <random>
 #include <span>
@@ -137,6 +138,13 @@ class FastSlam {
   /// plus between particles). Taken after the last update and before its resampling, which would
   /// duplicate particles and shrink the spread.
   PoseEstimate pose() const;
+  /// How many particles pose()'s covariance rests on where the particles are points in their sampled
+  /// entries (FastSLAM 1.0, whose weights depend on the draws): 1 / sum of the squared weights, the
+  /// particles at one pose counted as one. Below the pose's dimension + 1 that covariance is a sample
+  /// too small to span the pose's directions, and its NEES measures the sample, not the filter.
+  /// +inf where every particle reports a Gaussian (FastSLAM 2.0's proposals, a predict's motion, the
+  /// dead-reckoned frame before the first landmark).
+  double pose_sample_support() const;
   MapEstimate map() const;
   LandmarkEstimate<M> landmark(LandmarkId id) const;
   bool has_landmark(LandmarkId id) const;
@@ -164,6 +172,7 @@ class FastSlam {
     std::vector<Particle> particles;
     std::mt19937_64 rng;
     std::optional<PoseEstimate> estimate;
+    double support;  ///< pose_sample_support() of `estimate`
     std::vector<PendingMotion> pending;
     LandmarkId next_unassociated_id;
     bool resampled = false;
@@ -171,7 +180,7 @@ class FastSlam {
     bool frame_fixed;
   };
   Transaction begin() const {
-    return {particles_, rng_, estimate_, pending_, next_unassociated_id_, false, frame_cov_, frame_fixed_};
+    return {particles_, rng_, estimate_, support_, pending_, next_unassociated_id_, false, frame_cov_, frame_fixed_};
   }
   /// Before the first landmark the particles would differ only by where they put the map (a rigid
   /// motion no later measurement can see): they move together at the dead-reckoned mean, and the
@@ -225,6 +234,8 @@ class FastSlam {
   void normalize_and_resample(Transaction& t) const;
   PoseEstimate cloud_estimate(const std::vector<Particle>& cloud, const std::vector<PendingMotion>& pending) const;
   PoseEstimate pose_component(const Particle& particle, const std::vector<PendingMotion>& pending) const;
+  double point_support(const std::vector<Particle>& cloud, const std::vector<PendingMotion>& pending,
+                       bool frame_fixed) const;
   static std::vector<double> normalized_weights(const std::vector<Particle>& particles);
   static double effective_sample_size_of(const std::vector<double>& normalized);
   bool is_current(std::size_t index) const {
@@ -253,6 +264,7 @@ class FastSlam {
   std::mt19937_64 rng_;
   std::size_t resamplings_ = 0;
   std::optional<PoseEstimate> estimate_;  ///< the weighted cloud of the last update, before resampling
+  double support_ = std::numeric_limits<double>::infinity();  ///< pose_sample_support() of estimate_
   /// Uncertainty of the frame the particles map in, relative to the prior's: the prior and the motion
   /// before the first landmark (dead reckoning, not sampled); frozen from the first landmark on and
   /// added to the reported covariances (without the lever arm of its rotation part).

@@ -27,6 +27,9 @@ template <class State>
 struct RunSummary {
   std::vector<double> pose_error;  ///< AE of the position after each step (eq. 108)
   std::vector<double> pose_nees;   ///< NEES of the pose after each step (eq. 110)
+  /// A particle filter's pose_sample_support() after each step (empty for other back-ends): how many
+  /// effective particles the pose covariance, and so its NEES, rests on.
+  std::vector<double> pose_support;
   std::vector<double> seconds;     ///< time of each step
   std::vector<State> trajectory;   ///< pose mean after each step
   std::vector<double> map_error;   ///< AE of each landmark of the final map (eq. 109)
@@ -123,6 +126,7 @@ RunSummary<typename Backend::State> evaluate_run(Backend& backend, const Dataset
   std::size_t steps_with_map = 0;
   const auto record = run(backend, dataset.steps, [&](std::size_t k, const Backend& b) {
     on_step(k);
+    if constexpr (requires { b.pose_sample_support(); }) out.pose_support.push_back(b.pose_sample_support());
     const auto map = b.map();
     if (map.empty()) return;
     map_error_sum += mean(evaluate_map(map, dataset.true_landmarks).errors);
@@ -188,9 +192,8 @@ RunScores scores_of(const RunSummary<State>& r, int pose_dof, int landmark_dof, 
   s.map_mae = mean(r.map_error);
   s.map_mae_over_time = r.map_error_over_time;
   s.map_mae_aligned = mean(r.map_error_aligned);
-  s.pose_nees_inside = fraction_at_most(r.pose_nees, nees_upper_bound(pose_dof, confidence));
+  add_pose_consistency(s, r.pose_nees, r.pose_support, pose_dof, confidence);
   s.map_nees_inside = fraction_at_most(r.map_nees, nees_upper_bound(landmark_dof, confidence));
-  s.pose_anees = mean(r.pose_nees);
   s.total_seconds = r.total_seconds;
   s.failed_steps = r.failures.total();
   s.first_failure = r.failures.first;

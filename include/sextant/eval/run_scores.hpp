@@ -22,6 +22,10 @@ struct RunScores {
   double map_mae = 0.0, map_mae_over_time = 0.0, map_mae_aligned = 0.0;
   double pose_nees_inside = 0.0, map_nees_inside = 0.0;  ///< fractions inside the one-sided NEES bound
   double pose_anees = 0.0;                              ///< mean pose NEES over the run's steps
+  /// Share of the steps whose pose covariance rests on fewer effective particles than the pose has
+  /// dimensions + 1 (a particle filter's collapsed cloud of points): its NEES there measures the
+  /// sample, not the filter, and the step does not count as inside the bound.
+  double pose_undersampled = 0.0;
   double total_seconds = 0.0;
   std::size_t failed_steps = 0;  ///< steps skipped (StepErrors::skip)
   std::string first_failure;     ///< the first skipped step's message
@@ -39,6 +43,7 @@ struct Summary {
   double total_seconds = 0.0, seconds_per_step = 0.0;
   double pose_anees = 0.0;
   std::optional<Interval> anees_interval;
+  double pose_undersampled = 0.0;  ///< RunScores::pose_undersampled averaged over runs
   double pose_mae_std = 0.0;  ///< standard deviation of the per-run pose MAE
   double map_mae_std = 0.0;
   std::size_t failed_steps = 0;  ///< steps skipped over all runs (StepErrors::skip)
@@ -48,10 +53,29 @@ struct Summary {
   void mark_unscored() {
     constexpr double none = std::numeric_limits<double>::quiet_NaN();
     pose_mae = map_mae = map_mae_over_time = pose_rmse = pose_rmse_aligned = pose_mae_aligned = map_mae_aligned = none;
-    pose_nees_inside = map_nees_inside = pose_anees = pose_mae_std = map_mae_std = none;
+    pose_nees_inside = map_nees_inside = pose_anees = pose_mae_std = map_mae_std = pose_undersampled = none;
     anees_interval.reset();
   }
 };
+
+/// The pose's NEES scores of one run: the share of steps inside the one-sided bound at `confidence`,
+/// the average, and the share of steps whose covariance rests on fewer than pose_dof + 1 effective
+/// particles (`support`, per step; empty: every step's covariance is a Gaussian's), which never
+/// count as inside.
+inline void add_pose_consistency(RunScores& s, const std::vector<double>& nees, const std::vector<double>& support,
+                                 int pose_dof, double confidence) {
+  const double bound = nees_upper_bound(pose_dof, confidence);
+  std::size_t inside = 0, undersampled = 0;
+  for (std::size_t k = 0; k < nees.size(); ++k) {
+    const bool sampled_too_thinly = k < support.size() && support[k] < pose_dof + 1.0;
+    undersampled += sampled_too_thinly;
+    inside += !sampled_too_thinly && nees[k] <= bound;
+  }
+  const double steps = static_cast<double>(std::max<std::size_t>(1, nees.size()));
+  s.pose_nees_inside = static_cast<double>(inside) / steps;
+  s.pose_undersampled = static_cast<double>(undersampled) / steps;
+  s.pose_anees = mean(nees);
+}
 
 namespace detail {
 inline double sample_standard_deviation(const std::vector<double>& v) {
@@ -80,6 +104,7 @@ inline Summary summarize(const std::vector<RunScores>& runs, int pose_dof, doubl
     s.map_mae_over_time += r.map_mae_over_time / n;
     s.pose_mae_aligned += r.pose_mae_aligned / n;
     s.map_mae_aligned += r.map_mae_aligned / n;
+    s.pose_undersampled += r.pose_undersampled / n;
     nees_averages.push_back(r.pose_anees);
     s.failed_steps += r.failed_steps;
     if (s.first_failure.empty()) s.first_failure = r.first_failure;

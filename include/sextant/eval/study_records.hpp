@@ -62,12 +62,12 @@ inline std::string record_file_name(const Shard& shard) {
 
 namespace detail {
 
-inline constexpr const char* kRecordsMagic = "# sextant run records 1";
+inline constexpr const char* kRecordsMagic = "# sextant run records 2";
 inline constexpr const char* kRecordColumns =
     "dataset\tcell\tlabel\tpose_dof\tseed\tsteps\tpose_mae\tpose_rmse\tpose_rmse_aligned\tpose_mae_aligned\tmap_mae\t"
-    "map_mae_over_time\tmap_mae_aligned\tpose_nees_inside\tmap_nees_inside\tpose_anees\ttotal_seconds\tfailed_steps\t"
-    "first_failure\tfailure\textras";
-inline constexpr std::size_t kRecordFields = 21;
+    "map_mae_over_time\tmap_mae_aligned\tpose_nees_inside\tmap_nees_inside\tpose_anees\tpose_undersampled\ttotal_seconds\t"
+    "failed_steps\tfirst_failure\tfailure\textras";
+inline constexpr std::size_t kRecordFields = 22;
 
 /// A double as text that reads back to the same double (17 significant digits; nan, inf, -inf).
 inline std::string exact(double x) {
@@ -100,6 +100,7 @@ inline std::vector<std::pair<double RunScores::*, const char*>> score_fields() {
           {&RunScores::pose_nees_inside, "pose_nees_inside"},
           {&RunScores::map_nees_inside, "map_nees_inside"},
           {&RunScores::pose_anees, "pose_anees"},
+          {&RunScores::pose_undersampled, "pose_undersampled"},
           {&RunScores::total_seconds, "total_seconds"}};
 }
 
@@ -197,10 +198,10 @@ class RecordParser {
     r.scores.steps = whole<std::size_t>(f[5], "steps");
     std::size_t column = 6;
     for (const auto& [field, name] : score_fields()) r.scores.*field = number(f[column++], name);
-    r.scores.failed_steps = whole<std::size_t>(f[17], "failed_steps");
-    r.scores.first_failure = unescaped(f[18]);
-    r.failure = unescaped(f[19]);
-    r.extras = extras(f[20]);
+    r.scores.failed_steps = whole<std::size_t>(f[column++], "failed_steps");
+    r.scores.first_failure = unescaped(f[column++]);
+    r.failure = unescaped(f[column++]);
+    r.extras = extras(f[column]);
     return r;
   }
 
@@ -261,7 +262,7 @@ inline RecordFile parse_records(std::istream& in, const std::string& name) {
   } catch (const invalid_input_error& e) {
     p.fail(e.what());
   }
-  if (!p.next(in, text) || text != detail::kRecordColumns) p.fail("expected the column names of format 1");
+  if (!p.next(in, text) || text != detail::kRecordColumns) p.fail("expected the column names of format 2");
   while (p.next(in, text)) {
     const auto f = p.fields(text);
     if (f.size() == 2 && f[0] == "end") {

@@ -73,6 +73,7 @@ void FastSlam<Motion, Sensor, Map>::commit(Transaction&& t) {
   particles_ = std::move(t.particles);
   rng_ = t.rng;
   estimate_ = std::move(t.estimate);
+  support_ = t.support;
   pending_ = std::move(t.pending);
   next_unassociated_id_ = t.next_unassociated_id;
   if (t.resampled) ++resamplings_;
@@ -97,6 +98,7 @@ void FastSlam<Motion, Sensor, Map>::predict_without_map(const Control& u, double
     particle.forget_proposal();
   }
   t.estimate = PoseEstimate{p.x, total};
+  t.support = std::numeric_limits<double>::infinity();
   commit(std::move(t));
 }
 
@@ -124,6 +126,7 @@ void FastSlam<Motion, Sensor, Map>::predict(const Control& u, double dt) {
   else
     for (const auto& particle : t.particles) checked_motion_prediction(motion_, particle.x, u, dt);
   t.estimate = cloud_estimate(t.particles, t.pending);  // pose() after an accepted predict cannot throw
+  t.support = point_support(t.particles, t.pending, t.frame_fixed);
   commit(std::move(t));
 }
 
@@ -289,8 +292,8 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
   }
   result.corrected = known.size() - result.rejected.size() - known_unusable;
   result.initialized = added.size();
+  normalize_and_resample(t);  // with the frame as the particles were drawn in (point_support)
   fix_frame_if_mapped(t);
-  normalize_and_resample(t);
   auto index = index_;
   auto id_of_index = id_of_index_;
   for (const auto& observation : added) {
@@ -349,8 +352,8 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
   t.pending.clear();
   t.next_unassociated_id += measurements.size();
   const std::size_t initialized = started[best_particle(t.particles)];
+  normalize_and_resample(t);  // with the frame as the particles were drawn in (point_support)
   fix_frame_if_mapped(t);
-  normalize_and_resample(t);
   commit(std::move(t));
   return {measurements.size() - initialized, initialized, {}, {}};
 }
@@ -368,6 +371,7 @@ void FastSlam<Motion, Sensor, Map>::normalize_and_resample(Transaction& t) const
   const double log_total = max_log + std::log(sum);
   for (auto& p : particles) p.log_weight -= log_total;
   t.estimate = cloud_estimate(particles, t.pending);
+  t.support = point_support(particles, t.pending, t.frame_fixed);
   const double n = static_cast<double>(particles.size());
   const auto w = normalized_weights(particles);
   if (effective_sample_size_of(w) >= options_.resample_threshold * n) return;
@@ -432,6 +436,41 @@ std::size_t FastSlam<Motion, Sensor, Map>::best_particle(const std::vector<Parti
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::pose() const -> PoseEstimate {
   return estimate_ ? *estimate_ : cloud_estimate(particles_, pending_);
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+double FastSlam<Motion, Sensor, Map>::pose_sample_support() const {
+  return estimate_ ? support_ : point_support(particles_, pending_, frame_fixed_);
+}
+
+/// 1 / sum W_g^2 over the groups g of particles at one pose (W_g their summed weight), where every
+/// pose component is a point in the sampled entries; otherwise +inf (see pose_sample_support()).
+template <class Motion, class Sensor, template <class> class Map>
+double FastSlam<Motion, Sensor, Map>::point_support(const std::vector<Particle>& cloud,
+                                                    const std::vector<PendingMotion>& pending, bool frame_fixed) const {
+  constexpr double kGaussians = std::numeric_limits<double>::infinity();
+  const int sampled = keeps_tail() ? X - T : X;
+  if (!frame_fixed || !pending.empty()) return kGaussians;
+  for (const auto& particle : cloud)
+    if (!particle.drawn_cov.topLeftCorner(sampled, sampled).isZero(0.0)) return kGaussians;
+  const auto w = normalized_weights(cloud);
+  std::vector<Eigen::Matrix<double, X, 1>> d;
+  for (const auto& particle : cloud) d.push_back(Space::minus(particle.drawn_from, cloud.front().drawn_from));
+  std::vector<std::size_t> order(cloud.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  const auto before = [&](std::size_t a, std::size_t b) {
+    return std::lexicographical_compare(d[a].data(), d[a].data() + X, d[b].data(), d[b].data() + X);
+  };
+  std::sort(order.begin(), order.end(), before);
+  double sum_sq = 0.0, group = 0.0;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    group += w[order[i]];
+    if (i + 1 == order.size() || d[order[i + 1]] != d[order[i]]) {
+      sum_sq += group * group;
+      group = 0.0;
+    }
+  }
+  return 1.0 / sum_sq;
 }
 
 /// One particle's pose Gaussian: after a predict of FastSLAM 2.0 (pending motions), its draw carried
