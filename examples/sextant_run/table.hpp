@@ -98,7 +98,8 @@ inline void print_row(const TableRow& row) {
                 cloud->effective_sample_size, cloud->particles, cloud->distinct_ancestors, cloud->particles);
   if (s.pose_undersampled > 0.0)
     std::printf("%-29s collapsed: at %.1f%% of the steps the pose rests on fewer than dof + 1 effective particles, "
-                "its NEES there the sample's\n", "", 100.0 * s.pose_undersampled);
+                "its NEES there the sample's; the ANEES over the other steps: %s\n", "", 100.0 * s.pose_undersampled,
+                cell("%.4g", s.pose_anees_supported).c_str());
   if (const auto& r = row.relocalization) print_relocalization(29, *r);
   print_skipped_steps(29, row.summary.failed_steps, "step", row.summary.first_failure);  // over all its runs
 }
@@ -142,6 +143,7 @@ inline void write_summary_json(const std::string& path, const std::vector<TableR
         << ", \"map_mae_aligned\": " << json_number(s.map_mae_aligned) << ", \"pose_nees_inside\": " << json_number(s.pose_nees_inside)
         << ", \"map_nees_inside\": " << json_number(s.map_nees_inside) << ", \"pose_anees\": " << json_number(s.pose_anees)
         << ", \"pose_undersampled\": " << json_number(s.pose_undersampled)
+        << ", \"pose_anees_supported\": " << json_number(s.pose_anees_supported)
         << ", \"total_seconds\": " << json_number(s.total_seconds)
         << ", \"seconds_per_step\": " << json_number(s.seconds_per_step) << ", \"failed_steps\": " << s.failed_steps;
     if (const auto& f = rows[i].failure) out << ", \"failure\": \"" << json_escaped(*f) << "\"";

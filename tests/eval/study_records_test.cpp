@@ -89,7 +89,7 @@ void expect_same_summary(const Summary& a, const Summary& b) {
                      &Summary::pose_rmse_aligned, &Summary::pose_mae_aligned, &Summary::map_mae_aligned,
                      &Summary::pose_nees_inside, &Summary::map_nees_inside, &Summary::total_seconds,
                      &Summary::seconds_per_step, &Summary::pose_anees, &Summary::pose_mae_std, &Summary::map_mae_std,
-                     &Summary::pose_undersampled})
+                     &Summary::pose_undersampled, &Summary::pose_anees_supported})
     expect_same_bits(a.*field, b.*field, "a score");
   ASSERT_EQ(a.anees_interval.has_value(), b.anees_interval.has_value());
   if (a.anees_interval) {
@@ -124,10 +124,14 @@ TEST(RunScores, AStepWhosePoseRestsOnTooFewParticlesIsUndersampledAndNeverInside
   EXPECT_DOUBLE_EQ(s.pose_undersampled, 2.0 / 5.0);  // steps 2 and 4
   EXPECT_DOUBLE_EQ(s.pose_nees_inside, 2.0 / 5.0);   // steps 0 and 3: 1 is above the bound
   EXPECT_DOUBLE_EQ(s.pose_anees, 22.0);              // the raw average, kept for the record
+  EXPECT_DOUBLE_EQ(s.pose_anees_supported, 104.0 / 3.0);  // steps 0, 1, 3
   r.pose_support.clear();                            // a Gaussian back-end's run
   const auto gaussian = scores_of(r, 2, 2);
   EXPECT_EQ(gaussian.pose_undersampled, 0.0);
   EXPECT_DOUBLE_EQ(gaussian.pose_nees_inside, 4.0 / 5.0);
+  EXPECT_DOUBLE_EQ(gaussian.pose_anees_supported, gaussian.pose_anees);
+  r.pose_support.assign(5, 1.0);  // every step collapsed: no supported average
+  EXPECT_TRUE(std::isnan(scores_of(r, 2, 2).pose_anees_supported));
 }
 
 TEST(StudyRecords, MergedShardsAverageToTheBitLikeTheRunsInOneProcess) {

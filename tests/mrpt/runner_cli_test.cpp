@@ -361,6 +361,7 @@ TEST_F(RunnerCli, ACollapsedCloudSaysSoInsteadOfPrintingItsNees) {
   text << json.rdbuf();
   EXPECT_NE(text.str().find("\"pose_undersampled\": 0.9"), std::string::npos) << text.str();  // most steps
   EXPECT_NE(text.str().find("\"pose_undersampled\": 0,"), std::string::npos) << text.str();   // FastSLAM 2.0
+  EXPECT_NE(note.find("; the ANEES over the other steps: "), std::string::npos) << r.out;
 }
 
 /// eseif is SEIF with relocalization beside seif, the thesis's, with a line saying how often it

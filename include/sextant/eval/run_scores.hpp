@@ -26,6 +26,7 @@ struct RunScores {
   /// dimensions + 1 (a particle filter's collapsed cloud of points): its NEES there measures the
   /// sample, not the filter, and the step does not count as inside the bound.
   double pose_undersampled = 0.0;
+  double pose_anees_supported = 0.0;  ///< mean pose NEES over the steps that are not undersampled (NaN: none is)
   double total_seconds = 0.0;
   std::size_t failed_steps = 0;  ///< steps skipped (StepErrors::skip)
   std::string first_failure;     ///< the first skipped step's message
@@ -44,6 +45,7 @@ struct Summary {
   double pose_anees = 0.0;
   std::optional<Interval> anees_interval;
   double pose_undersampled = 0.0;  ///< RunScores::pose_undersampled averaged over runs
+  double pose_anees_supported = 0.0;  ///< RunScores::pose_anees_supported averaged over runs
   double pose_mae_std = 0.0;  ///< standard deviation of the per-run pose MAE
   double map_mae_std = 0.0;
   std::size_t failed_steps = 0;  ///< steps skipped over all runs (StepErrors::skip)
@@ -53,7 +55,8 @@ struct Summary {
   void mark_unscored() {
     constexpr double none = std::numeric_limits<double>::quiet_NaN();
     pose_mae = map_mae = map_mae_over_time = pose_rmse = pose_rmse_aligned = pose_mae_aligned = map_mae_aligned = none;
-    pose_nees_inside = map_nees_inside = pose_anees = pose_mae_std = map_mae_std = pose_undersampled = none;
+    pose_nees_inside = map_nees_inside = pose_anees = pose_mae_std = map_mae_std = pose_undersampled =
+        pose_anees_supported = none;
     anees_interval.reset();
   }
 };
@@ -61,20 +64,25 @@ struct Summary {
 /// The pose's NEES scores of one run: the share of steps inside the one-sided bound at `confidence`,
 /// the average, and the share of steps whose covariance rests on fewer than pose_dof + 1 effective
 /// particles (`support`, per step; empty: every step's covariance is a Gaussian's), which never
-/// count as inside.
+/// count as inside; the average over the other steps beside the average over all.
 inline void add_pose_consistency(RunScores& s, const std::vector<double>& nees, const std::vector<double>& support,
                                  int pose_dof, double confidence) {
   const double bound = nees_upper_bound(pose_dof, confidence);
   std::size_t inside = 0, undersampled = 0;
+  double supported_sum = 0.0;
   for (std::size_t k = 0; k < nees.size(); ++k) {
     const bool sampled_too_thinly = k < support.size() && support[k] < pose_dof + 1.0;
     undersampled += sampled_too_thinly;
     inside += !sampled_too_thinly && nees[k] <= bound;
+    if (!sampled_too_thinly) supported_sum += nees[k];
   }
   const double steps = static_cast<double>(std::max<std::size_t>(1, nees.size()));
   s.pose_nees_inside = static_cast<double>(inside) / steps;
   s.pose_undersampled = static_cast<double>(undersampled) / steps;
   s.pose_anees = mean(nees);
+  if (undersampled == 0) s.pose_anees_supported = s.pose_anees;
+  else if (undersampled == nees.size()) s.pose_anees_supported = std::numeric_limits<double>::quiet_NaN();
+  else s.pose_anees_supported = supported_sum / static_cast<double>(nees.size() - undersampled);
 }
 
 namespace detail {
@@ -105,6 +113,7 @@ inline Summary summarize(const std::vector<RunScores>& runs, int pose_dof, doubl
     s.pose_mae_aligned += r.pose_mae_aligned / n;
     s.map_mae_aligned += r.map_mae_aligned / n;
     s.pose_undersampled += r.pose_undersampled / n;
+    s.pose_anees_supported += r.pose_anees_supported / n;
     nees_averages.push_back(r.pose_anees);
     s.failed_steps += r.failed_steps;
     if (s.first_failure.empty()) s.first_failure = r.first_failure;

@@ -65,9 +65,9 @@ namespace detail {
 inline constexpr const char* kRecordsMagic = "# sextant run records 2";
 inline constexpr const char* kRecordColumns =
     "dataset\tcell\tlabel\tpose_dof\tseed\tsteps\tpose_mae\tpose_rmse\tpose_rmse_aligned\tpose_mae_aligned\tmap_mae\t"
-    "map_mae_over_time\tmap_mae_aligned\tpose_nees_inside\tmap_nees_inside\tpose_anees\tpose_undersampled\ttotal_seconds\t"
-    "failed_steps\tfirst_failure\tfailure\textras";
-inline constexpr std::size_t kRecordFields = 22;
+    "map_mae_over_time\tmap_mae_aligned\tpose_nees_inside\tmap_nees_inside\tpose_anees\tpose_undersampled\t"
+    "pose_anees_supported\ttotal_seconds\tfailed_steps\tfirst_failure\tfailure\textras";
+inline constexpr std::size_t kRecordFields = 23;
 
 /// A double as text that reads back to the same double (17 significant digits; nan, inf, -inf).
 inline std::string exact(double x) {
@@ -101,6 +101,7 @@ inline std::vector<std::pair<double RunScores::*, const char*>> score_fields() {
           {&RunScores::map_nees_inside, "map_nees_inside"},
           {&RunScores::pose_anees, "pose_anees"},
           {&RunScores::pose_undersampled, "pose_undersampled"},
+          {&RunScores::pose_anees_supported, "pose_anees_supported"},
           {&RunScores::total_seconds, "total_seconds"}};
 }
 
