@@ -78,9 +78,16 @@ class StudyRun {
 };
 
 /// "a [l, u]" for an ANEES and its interval; "a" alone when there is none (fewer than 2 runs, an
-/// infinite ANEES).
+/// infinite ANEES); "collapsed at p% (others: a)" where a particle cloud's pose rested on fewer than
+/// dof + 1 effective particles at some steps (eval::RunScores::pose_undersampled).
 inline std::string anees_with_interval(const eval::Summary& s, const char* format, int interval_decimals) {
   char text[96];
+  if (s.pose_undersampled > 0.0) {
+    std::snprintf(text, sizeof text, "collapsed at %.1f%% of the steps (others: ", 100.0 * s.pose_undersampled);
+    std::string out = text;
+    std::snprintf(text, sizeof text, format, s.pose_anees_supported);
+    return out + text + ")";
+  }
   std::snprintf(text, sizeof text, format, s.pose_anees);
   std::string out = text;
   if (s.anees_interval) {
