@@ -123,8 +123,8 @@ struct RunnerConfig {
   io::MrclamOptions mrclam;
   bool mrclam_filters_in_world_frame = true;  ///< [mrclam] filters_in_world_frame
   /// [mrclam] gate_probability and graph_robust_kernel: what docs/results/mrclam.md recommends for
-  /// real robots (heavy-tailed outliers), set on the back-ends for MRCLAM runs whatever [ekf], [seif],
-  /// [fastslam] gate_probability and [graph] robust_kernel say.
+  /// real robots (heavy-tailed outliers), set on the back-ends for MRCLAM runs whatever [ekf], [seif]
+  /// gate_probability and [graph] robust_kernel say; FastSLAM keeps [fastslam] gate_probability.
   double mrclam_gate_probability = 0.9999;
   RobustKernel mrclam_graph_kernel = RobustKernel::cauchy;
   int mrclam_reacquire_after_landmarks = 3;  ///< [mrclam] reacquire_after_landmarks (docs/results/mrclam.md, stress cases)
@@ -440,7 +440,7 @@ inline std::vector<ConfigKey> mrclam_keys() {
        std::copy(values.begin(), values.end(), c.mrclam.motion.alpha.begin());
      }},
     {"mrclam", "gate_probability", "0.9999",
-     "MRCLAM: Mahalanobis gate of EKF, SEIF and FastSLAM (real data has outliers; 0 = off); overrides their own",
+     "MRCLAM: Mahalanobis gate of EKF and SEIF (real data has outliers; 0 = off); overrides their own (FastSLAM keeps [fastslam]'s)",
      [](RunnerConfig& c, const std::string& v) { c.mrclam_gate_probability = parse_gate_probability(v); }},
     {"mrclam", "reacquire_after_landmarks", "3",
      "MRCLAM: the EKF re-acquires a pose lost beyond its covariance (with the gate on; 0 = never); overrides [ekf]",
@@ -636,7 +636,7 @@ inline std::vector<ConfigKey> pose_graph_keys() {
 /// [fastslam]: FastSLAM's options.
 inline std::vector<ConfigKey> fastslam_keys() {
   return {
-    {"fastslam", "gate_probability", "0", "per-particle Mahalanobis gate on known landmarks; 0 = off",
+    {"fastslam", "gate_probability", "0", "Mahalanobis gate on known landmarks, against the particle cloud's predictive distribution; 0 = off",
      [](RunnerConfig& c, const std::string& v) { c.fastslam.gate_probability = parse_gate_probability(v); }},
     {"fastslam", "particles", "100", "particles",
      [](RunnerConfig& c, const std::string& v) { c.fastslam.particles = parse_integer<std::size_t>(v, 1, 1e6); }},

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <set>
@@ -473,6 +474,42 @@ TEST_P(FastVersions, LandmarksFromUnassociatedMeasurementsAreReportedAndMapped) 
       if (particle.unassociated[j].id == map[1].id) {
         EXPECT_FALSE(particle.unassociated[j].alive);
       }
+}
+
+/// The gate tests a sighting against the cloud's predictive distribution, not each particle's: after
+/// 400 steps without sightings the particles have spread 1 m along the track (one step: 5 cm), and a
+/// sighting from 1.5 standard deviations off the cloud's mean is inside the cloud's 0.9999 gate
+/// (NIS about 2.3 against 18.4) but beyond a single step's reach for most particles. Every
+/// FastSLAM 2.0 particle must then use it (its proposal pulls it to the sighting: gain
+/// R / (R + Q + Sigma_m) = 0.98 of 1.5 m, so within 0.1 m; a particle that ignored it would stay up
+/// to metres away, as a per-particle gate left the cloud of MRCLAM robot 3), and a
+/// sighting 30 standard deviations off must be rejected by every particle, its landmark untouched.
+TEST(FastSlam, TheGateAsksTheCloudSoADriftedCloudUsesTheSightingsThatBringItBack) {
+  const BeaconShip2D motion{0.05, 0.01, HeadingNoise::linearized};
+  const BeaconOffset2D sensor{0.005};
+  const Gaussian<Eigen::Vector2d, 2> prior{Eigen::Vector2d::Zero(), 1e-12 * Eigen::Matrix2d::Identity()};
+  Fast fast{motion, sensor, prior,
+            {.particles = 100, .version = FastSlamVersion::v2, .resample_threshold = 0.0, .seed = 5,
+             .gate_probability = 0.9999}};
+  const Eigen::Vector2d landmark(0.0, 5.0);
+  fast.update(std::vector<Fast::ObservationType>{{7, landmark}});
+  for (int k = 0; k < 400; ++k) fast.predict(Eigen::Vector2d(0.1, 0.0), 1.0);
+  const double spread = std::sqrt(fast.pose().cov(0, 0));
+  ASSERT_GT(spread, 0.7);
+  const Eigen::Vector2d truth = fast.pose().mean + Eigen::Vector2d(1.5 * spread, 0.0);
+  const Eigen::Vector2d far = fast.pose().mean + Eigen::Vector2d(30.0 * spread, 0.0);
+
+  Fast outlier = fast;
+  const auto rejected = outlier.update(std::vector<Fast::ObservationType>{{7, landmark - far}});
+  EXPECT_EQ(rejected.rejected, std::vector<LandmarkId>{7});
+  for (const auto& particle : outlier.particles()) EXPECT_LT((particle.landmarks[0].mean - landmark).norm(), 0.05);
+
+  const auto used = fast.update(std::vector<Fast::ObservationType>{{7, landmark - truth}});
+  EXPECT_TRUE(used.rejected.empty());
+  EXPECT_EQ(used.corrected, 1u);
+  double farthest = 0.0;
+  for (const auto& particle : fast.particles()) farthest = std::max(farthest, (particle.x - truth).norm());
+  EXPECT_LT(farthest, 0.1);
 }
 
 TEST(FastSlam, RejectsBadOptions) {

@@ -57,10 +57,10 @@ struct FastSlamOptions {
   /// Ids given to the landmarks that particles create in update_unassociated: first, first + 1, ...
   /// A landmark keeps its id in every particle that descends from the one that created it.
   LandmarkId first_unassociated_id = LandmarkId{1} << 62;
-  /// In (0, 1), per particle: an observation of a known landmark whose innovation fails the
-  /// chi-square test (core/innovation_gate.hpp) is not applied to that particle's landmark and
-  /// weighs as a measurement on the gate's edge, like a new landmark. UpdateResult::rejected lists
-  /// the observations the most likely particle rejected. 0 = off.
+  /// In (0, 1): an observation of a known landmark whose innovation fails the chi-square test
+  /// (core/innovation_gate.hpp) against the cloud's predictive distribution (the particles' mixture,
+  /// moment-matched: accepted_by_cloud) is used by no particle and weighs on none;
+  /// UpdateResult::rejected lists them. Per particle, a particle would ignore what refutes it. 0 = off.
   double gate_probability = 0.0;
   /// docs/results/globe.md measures both on the 12D camera.
   FastSlamLinearTail linear_tail = FastSlamLinearTail::sampled;
@@ -216,17 +216,20 @@ class FastSlam {
   auto predict_if_observable(const State& x, const Landmark& m) const -> std::optional<Prediction>;
   std::vector<ObservationType> add_new_landmarks(std::vector<Particle>& particles, std::span<const ObservationType> fresh,
                                                  std::vector<LandmarkId>& unusable) const;
-  LandmarkUpdate update_landmark(Particle& particle, std::size_t index, const Measurement& z, bool unassociated,
-                                 bool gated) const;
+  LandmarkUpdate update_landmark(Particle& particle, std::size_t index, const Measurement& z, bool unassociated) const;
   template <class Llt>
   double log_likelihood_at_gate_edge(const Llt& llt) const;
   ProposalInnovation proposal_innovation(Prediction prediction, const PoseMatrix& cov, const LandmarkGaussian<M>& landmark,
                                          const Measurement& z) const;
   static double fold_into_proposal(State& mean, PoseMatrix& cov, const ProposalInnovation& innovation);
   std::vector<Outcome> sample_v2_proposal(Particle& particle, const PoseEstimate& prior,
-                                          std::span<const ObservationType> known, std::mt19937_64& rng) const;
+                                          std::span<const ObservationType> known, const std::vector<bool>& accepted,
+                                          std::mt19937_64& rng) const;
+  /// Per observation of a known landmark: whether the gate on the cloud lets it through.
+  std::vector<bool> accepted_by_cloud(const std::vector<Particle>& particles, std::span<const ObservationType> known,
+                                      const PendingMotion* motion) const;
   std::vector<Outcome> update_known_landmarks(Particle& particle, std::span<const ObservationType> known,
-                                              bool proposal, Transaction& t) const;
+                                              const std::vector<bool>& accepted, bool proposal, Transaction& t) const;
   std::size_t update_particle_unassociated(Particle& particle, std::span<const Measurement> measurements, bool proposal,
                                            Transaction& t) const;
   std::vector<std::size_t> associate_in_particle(Particle& particle, State& mean, PoseMatrix& cov,

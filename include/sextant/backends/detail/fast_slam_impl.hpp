@@ -151,11 +151,10 @@ double FastSlam<Motion, Sensor, Map>::log_likelihood_at_gate_edge(const Llt& llt
 }
 
 /// One landmark EKF update with the particle's pose (eqs. 75-78, Joseph form); returns the log
-/// likelihood log N(nu; 0, S), S = H_m Sigma_m H_m^T + Q (eqs. 79-81). With `gated` and the gate
-/// on, an innovation that fails the chi-square test leaves the landmark as it is.
+/// likelihood log N(nu; 0, S), S = H_m Sigma_m H_m^T + Q (eqs. 79-81).
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::size_t index, const Measurement& z,
-                                                    bool unassociated, bool gated) const -> LandmarkUpdate {
+                                                    bool unassociated) const -> LandmarkUpdate {
   auto& map = unassociated ? particle.unassociated : particle.landmarks;
   const LandmarkGaussian<M>& L = map[index];
   const auto prediction = predict_if_observable(particle.x, L.mean);
@@ -164,7 +163,6 @@ auto FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::siz
   const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(z, pred.z);
   const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
   const auto llt = cholesky_or_throw(S, "landmark innovation covariance");
-  if (gated && gate_.rejects(llt, nu)) return {log_likelihood_at_gate_edge(llt), Outcome::gated};
   const Eigen::Matrix<double, M, Z> K = llt.solve(pred.J_z_m * L.cov).transpose();
   const Eigen::Matrix<double, M, M> I_KH = Eigen::Matrix<double, M, M>::Identity() - K * pred.J_z_m;
   LandmarkGaussian<M> updated{L.mean + K * nu, symmetrized(I_KH * L.cov * I_KH.transpose() + K * pred.Q * K.transpose()),
@@ -218,24 +216,23 @@ double FastSlam<Motion, Sensor, Map>::fold_into_proposal(State& mean, PoseMatrix
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const PoseEstimate& prior,
                                                        std::span<const ObservationType> known,
+                                                       const std::vector<bool>& accepted,
                                                        std::mt19937_64& rng) const -> std::vector<Outcome> {
   State mean = prior.mean;
   PoseMatrix cov = prior.cov;
   std::vector<Outcome> outcomes(known.size(), Outcome::used);
   for (std::size_t i = 0; i < known.size(); ++i) {
+    if (!accepted[i]) {
+      outcomes[i] = Outcome::gated;
+      continue;
+    }
     const LandmarkGaussian<M>& L = particle.landmarks[index_.at(known[i].landmark_id)];
     auto prediction = predict_if_observable(mean, L.mean);
     if (!prediction) {
       outcomes[i] = Outcome::unusable;
       continue;
     }
-    const auto innovation = proposal_innovation(std::move(*prediction), cov, L, known[i].z);
-    if (gate_.rejects(innovation.llt, innovation.nu)) {
-      particle.log_weight += log_likelihood_at_gate_edge(innovation.llt);
-      outcomes[i] = Outcome::gated;
-      continue;
-    }
-    particle.log_weight += fold_into_proposal(mean, cov, innovation);
+    particle.log_weight += fold_into_proposal(mean, cov, proposal_innovation(std::move(*prediction), cov, L, known[i].z));
   }
   if (!std::isfinite(particle.log_weight)) throw numerical_error("FastSLAM 2.0 proposal weight is not finite");
   draw_into(particle, {mean, cov}, rng);
@@ -244,26 +241,80 @@ auto FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const
   return outcomes;
 }
 
+/// The gate on the cloud (docs/results/mrclam.md, "FastSLAM's gate on the cloud"): an observation
+/// of a known landmark is an outlier when it is one for the filter's predictive distribution, the
+/// weighted mixture over particles of N(h(x_n, m_n), S_n) with S_n = H_x C_n H_x^T + H_m Sigma_m H_m^T
+/// + Q (C_n: the particle's pending motion, FastSLAM 2.0, or its tail), moment-matched: its NIS is
+/// nu^T S^-1 nu with nu = sum w_n nu_n and S = sum w_n (S_n + (nu_n - nu)(nu_n - nu)^T). Every
+/// particle then uses it or none does: a per-particle gate would let each particle ignore the
+/// sightings that refute it, and a cloud that has drifted (a long gap) would never come back.
+/// Particles that cannot predict it are left out; all true with the gate off.
+template <class Motion, class Sensor, template <class> class Map>
+std::vector<bool> FastSlam<Motion, Sensor, Map>::accepted_by_cloud(const std::vector<Particle>& particles,
+                                                                   std::span<const ObservationType> known,
+                                                                   const PendingMotion* motion) const {
+  std::vector<bool> accepted(known.size(), true);
+  if (!gate_.on() || known.empty()) return accepted;
+  const auto w = normalized_weights(particles);
+  std::vector<PoseEstimate> poses;
+  poses.reserve(particles.size());
+  for (const auto& particle : particles)
+    poses.push_back(motion ? motion_gaussian(particle.x, particle.cov, motion->u, motion->dt)
+                           : PoseEstimate{particle.x, particle.cov});
+  std::vector<Eigen::Matrix<double, Z, 1>> nus(particles.size());
+  std::vector<bool> predicted(particles.size());
+  for (std::size_t i = 0; i < known.size(); ++i) {
+    const std::size_t index = index_.at(known[i].landmark_id);
+    Eigen::Matrix<double, Z, 1> nu = Eigen::Matrix<double, Z, 1>::Zero();
+    Eigen::Matrix<double, Z, Z> S = Eigen::Matrix<double, Z, Z>::Zero();
+    double total = 0.0;
+    for (std::size_t n = 0; n < particles.size(); ++n) {
+      const LandmarkGaussian<M>& L = particles[n].landmarks[index];
+      const auto p = predict_if_observable(poses[n].mean, L.mean);
+      predicted[n] = p.has_value();
+      if (!p) continue;
+      nus[n] = sensor_.residual(known[i].z, p->z);
+      nu += w[n] * nus[n];
+      S += w[n] * (p->J_z_x * poses[n].cov * p->J_z_x.transpose() + p->J_z_m * L.cov * p->J_z_m.transpose() + p->Q);
+      total += w[n];
+    }
+    if (!(total > 0.0)) continue;  // no particle can predict it: each says so itself
+    nu /= total;
+    for (std::size_t n = 0; n < particles.size(); ++n)
+      if (predicted[n]) S += w[n] * (nus[n] - nu) * (nus[n] - nu).transpose();
+    S /= total;
+    if (!nu.allFinite() || !S.allFinite()) throw numerical_error("FastSLAM: the cloud's innovation is not finite");
+    accepted[i] = !gate_.rejects(cholesky_or_throw(symmetrized(S), "the cloud's innovation covariance"), nu);
+  }
+  return accepted;
+}
+
 /// One particle's known landmarks: with FastSLAM 2.0 the pose sampled from the proposal, then each
 /// landmark updated from it; with 1.0 each landmark updated and weighed (eq. 85).
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::update_known_landmarks(Particle& particle, std::span<const ObservationType> known,
-                                                           bool proposal, Transaction& t) const -> std::vector<Outcome> {
+                                                           const std::vector<bool>& accepted, bool proposal,
+                                                           Transaction& t) const -> std::vector<Outcome> {
   std::vector<Outcome> outcomes;
   if (!proposal) {
     particle.forget_proposal();
-    for (const auto& observation : known) {
-      const auto result = update_landmark(particle, index_.at(observation.landmark_id), observation.z, false, true);
+    for (std::size_t i = 0; i < known.size(); ++i) {
+      if (!accepted[i]) {
+        outcomes.push_back(Outcome::gated);
+        continue;
+      }
+      const auto result = update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false);
       particle.log_weight += result.log_likelihood;
       outcomes.push_back(result.outcome);
     }
     return outcomes;
   }
   const auto& motion = t.pending.back();
-  outcomes = sample_v2_proposal(particle, motion_gaussian(particle.x, particle.cov, motion.u, motion.dt), known, t.rng);
+  outcomes = sample_v2_proposal(particle, motion_gaussian(particle.x, particle.cov, motion.u, motion.dt), known,
+                                accepted, t.rng);
   for (std::size_t i = 0; i < known.size(); ++i)
     if (outcomes[i] == Outcome::used &&
-        update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false, false).outcome == Outcome::unusable)
+        update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false).outcome == Outcome::unusable)
       outcomes[i] = Outcome::unusable;  // behind the camera from the sampled pose
   return outcomes;
 }
@@ -276,8 +327,10 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
   const auto [known, fresh] = split_known_and_new(index_, observations);
   Transaction t = begin();
   const bool proposal = options_.version == FastSlamVersion::v2 && !t.pending.empty();
+  const std::vector<bool> accepted = accepted_by_cloud(t.particles, known, proposal ? &t.pending.back() : nullptr);
   std::vector<std::vector<Outcome>> outcomes(t.particles.size());
-  for (std::size_t n = 0; n < t.particles.size(); ++n) outcomes[n] = update_known_landmarks(t.particles[n], known, proposal, t);
+  for (std::size_t n = 0; n < t.particles.size(); ++n)
+    outcomes[n] = update_known_landmarks(t.particles[n], known, accepted, proposal, t);
   UpdateResult result;
   const auto added = add_new_landmarks(t.particles, fresh, result.unusable);
   t.pending.clear();
@@ -648,7 +701,7 @@ std::size_t FastSlam<Motion, Sensor, Map>::update_particle_unassociated(Particle
   std::size_t started = 0;
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     if (match[i] != kNewLandmark) {
-      const double log_likelihood = update_landmark(particle, match[i], measurements[i], true, false).log_likelihood;
+      const double log_likelihood = update_landmark(particle, match[i], measurements[i], true).log_likelihood;
       if (!proposal) particle.log_weight += log_likelihood;
       continue;
     }
