@@ -9,6 +9,7 @@
 #include "sextant/core/error.hpp"
 #include "sextant/core/factor_information.hpp"
 #include "sextant/core/gaussian.hpp"
+#include "sextant/core/gaussian_mixture.hpp"
 #include "sextant/core/landmark_pool.hpp"
 #include "sextant/core/landmark_pool_policy.hpp"
 #include "sextant/core/landmark_store.hpp"

@@ -8,6 +8,7 @@
 #include <numeric>
 #include <string>
 
+#include "sextant/core/gaussian_mixture.hpp"
 #include "sextant/core/landmark_init.hpp"
 #include "sextant/core/validation.hpp"
 
@@ -262,29 +263,28 @@ std::vector<bool> FastSlam<Motion, Sensor, Map>::accepted_by_cloud(const std::ve
     poses.push_back(motion ? motion_gaussian(particle.x, particle.cov, motion->u, motion->dt)
                            : PoseEstimate{particle.x, particle.cov});
   std::vector<Eigen::Matrix<double, Z, 1>> nus(particles.size());
-  std::vector<bool> predicted(particles.size());
+  std::vector<Eigen::Matrix<double, Z, Z>> covs(particles.size());
   for (std::size_t i = 0; i < known.size(); ++i) {
     const std::size_t index = index_.at(known[i].landmark_id);
-    Eigen::Matrix<double, Z, 1> nu = Eigen::Matrix<double, Z, 1>::Zero();
-    Eigen::Matrix<double, Z, Z> S = Eigen::Matrix<double, Z, Z>::Zero();
+    std::vector<double> predicted_w(w.size(), 0.0);  // the weights of the particles that can predict it
     double total = 0.0;
     for (std::size_t n = 0; n < particles.size(); ++n) {
       const LandmarkGaussian<M>& L = particles[n].landmarks[index];
       const auto p = predict_if_observable(poses[n].mean, L.mean);
-      predicted[n] = p.has_value();
       if (!p) continue;
       nus[n] = sensor_.residual(known[i].z, p->z);
-      nu += w[n] * nus[n];
-      S += w[n] * (p->J_z_x * poses[n].cov * p->J_z_x.transpose() + p->J_z_m * L.cov * p->J_z_m.transpose() + p->Q);
+      covs[n] = p->J_z_x * poses[n].cov * p->J_z_x.transpose() + p->J_z_m * L.cov * p->J_z_m.transpose() + p->Q;
+      predicted_w[n] = w[n];
       total += w[n];
     }
     if (!(total > 0.0)) continue;  // no particle can predict it: each says so itself
-    nu /= total;
-    for (std::size_t n = 0; n < particles.size(); ++n)
-      if (predicted[n]) S += w[n] * (nus[n] - nu) * (nus[n] - nu).transpose();
-    S /= total;
-    if (!nu.allFinite() || !S.allFinite()) throw numerical_error("FastSLAM: the cloud's innovation is not finite");
-    accepted[i] = !gate_.rejects(cholesky_or_throw(symmetrized(S), "the cloud's innovation covariance"), nu);
+    for (double& v : predicted_w) v /= total;
+    const auto innovation = mixture_moments<Z>(predicted_w, [&](std::size_t n) { return nus[n]; },
+                                               [&](std::size_t n) { return covs[n]; });
+    if (!innovation.mean.allFinite() || !innovation.cov.allFinite())
+      throw numerical_error("FastSLAM: the cloud's innovation is not finite");
+    accepted[i] = !gate_.rejects(cholesky_or_throw(symmetrized(innovation.cov), "the cloud's innovation covariance"),
+                                 innovation.mean);
   }
   return accepted;
 }
@@ -548,16 +548,11 @@ auto FastSlam<Motion, Sensor, Map>::cloud_estimate(const std::vector<Particle>& 
   components.reserve(cloud.size());
   for (const auto& particle : cloud) components.push_back(pose_component(particle, pending));
   const State reference = components[best_particle(cloud)].mean;
-  Eigen::Matrix<double, X, 1> mean_d = Eigen::Matrix<double, X, 1>::Zero();
   std::vector<Eigen::Matrix<double, X, 1>> d;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    d.push_back(Space::minus(components[i].mean, reference));
-    mean_d += w[i] * d.back();
-  }
-  Eigen::Matrix<double, X, X> cov = Eigen::Matrix<double, X, X>::Zero();
-  for (std::size_t i = 0; i < cloud.size(); ++i)
-    cov += w[i] * (components[i].cov + (d[i] - mean_d) * (d[i] - mean_d).transpose());
-  PoseEstimate out{Space::plus(reference, mean_d), symmetrized(cov + frame_cov_)};
+  for (const auto& component : components) d.push_back(Space::minus(component.mean, reference));
+  const auto moments = mixture_moments<X>(w, [&](std::size_t i) { return d[i]; },
+                                          [&](std::size_t i) { return components[i].cov; });
+  PoseEstimate out{Space::plus(reference, moments.mean), symmetrized(moments.cov + frame_cov_)};
   if (!Space::is_finite(out.mean) || !out.cov.allFinite()) throw numerical_error("FastSLAM cloud pose estimate is not finite");
   return out;
 }
@@ -582,15 +577,9 @@ auto FastSlam<Motion, Sensor, Map>::landmark(LandmarkId id) const -> LandmarkEst
     const auto& L = particles_[best_particle()].landmarks[it->second];
     return {id, L.mean, in_world_frame(L.cov)};
   }
-  const auto w = weights();
-  Eigen::Matrix<double, M, 1> mean = Eigen::Matrix<double, M, 1>::Zero();
-  for (std::size_t i = 0; i < particles_.size(); ++i) mean += w[i] * particles_[i].landmarks[it->second].mean;
-  Eigen::Matrix<double, M, M> cov = Eigen::Matrix<double, M, M>::Zero();
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    const auto& L = particles_[i].landmarks[it->second];
-    cov += w[i] * (L.cov + (L.mean - mean) * (L.mean - mean).transpose());
-  }
-  return {id, mean, in_world_frame(symmetrized(cov))};
+  const auto moments = mixture_moments<M>(weights(), [&](std::size_t i) { return particles_[i].landmarks[it->second].mean; },
+                                          [&](std::size_t i) { return particles_[i].landmarks[it->second].cov; });
+  return {id, moments.mean, in_world_frame(symmetrized(moments.cov))};
 }
 
 /// The known landmarks (per options().map_estimate), then those the most likely particle created
