@@ -326,8 +326,13 @@ TEST(FastSlam, ResamplingCopiesEachParticleByItsWeightAndNormalizesTheWeights) {
     std::vector<std::size_t> copies(N, 0);
     for (const auto& particle : soon.particles()) {
       ++copies[particle.ancestor];  // no resampling before: particle i of `never` is ancestor i
-      EXPECT_EQ(particle.x, never.particles()[particle.ancestor].x);
+      EXPECT_EQ(particle.drawn_from, never.particles()[particle.ancestor].drawn_from);  // the parent's proposal
+      EXPECT_EQ(particle.drawn_cov, never.particles()[particle.ancestor].drawn_cov);
     }
+    // FastSLAM 2.0's weight does not depend on the draw, so it resamples before drawing: the copies of
+    // one particle drew their own poses from its proposal, none is the twin of another.
+    for (std::size_t a = 0; a < N; ++a)
+      for (std::size_t b = a + 1; b < N; ++b) EXPECT_NE(soon.particles()[a].x, soon.particles()[b].x) << a << ", " << b;
     for (std::size_t i = 0; i < N; ++i) {
       EXPECT_GE(static_cast<double>(copies[i]), std::floor(N * w[i]) - 1e-9) << "particle " << i << ", weight " << w[i];
       EXPECT_LE(static_cast<double>(copies[i]), std::ceil(N * w[i]) + 1e-9) << "particle " << i << ", weight " << w[i];

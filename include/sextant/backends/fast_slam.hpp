@@ -119,7 +119,10 @@ class FastSlam {
   FastSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, FastSlamOptions options = {});
 
   /// FastSLAM 1.0 samples every particle's pose here; 2.0 only predicts the mean and samples in
-  /// update(), where the measurements shape the proposal.
+  /// update(), where the measurements shape the proposal. FastSLAM 2.0's weight (eq. 93) depends on
+  /// the particle before the draw, so update() weighs and resamples the cloud first and each copy of
+  /// a particle then draws its own pose from the proposal (the fully adapted order, Pitt and
+  /// Shephard 1999; docs/results/fastslam_gap.md): resampling never leaves identical copies.
   void predict(const Control& u, double dt);
   /// Observations with known landmark ids; new ids are added to every particle.
   UpdateResult update(std::span<const ObservationType> observations);
@@ -222,19 +225,23 @@ class FastSlam {
   ProposalInnovation proposal_innovation(Prediction prediction, const PoseMatrix& cov, const LandmarkGaussian<M>& landmark,
                                          const Measurement& z) const;
   static double fold_into_proposal(State& mean, PoseMatrix& cov, const ProposalInnovation& innovation);
-  std::vector<Outcome> sample_v2_proposal(Particle& particle, const PoseEstimate& prior,
-                                          std::span<const ObservationType> known, const std::vector<bool>& accepted,
-                                          std::mt19937_64& rng) const;
+  std::vector<Outcome> propose_v2(Particle& particle, const PoseEstimate& prior, std::span<const ObservationType> known,
+                                  const std::vector<bool>& accepted) const;
+  void draw_from_proposal(Particle& particle, std::span<const ObservationType> known, std::vector<Outcome>& outcomes,
+                          std::mt19937_64& rng) const;
   /// Per observation of a known landmark: whether the gate on the cloud lets it through.
   std::vector<bool> accepted_by_cloud(const std::vector<Particle>& particles, std::span<const ObservationType> known,
                                       const PendingMotion* motion) const;
   std::vector<Outcome> update_known_landmarks(Particle& particle, std::span<const ObservationType> known,
-                                              const std::vector<bool>& accepted, bool proposal, Transaction& t) const;
-  std::size_t update_particle_unassociated(Particle& particle, std::span<const Measurement> measurements, bool proposal,
-                                           Transaction& t) const;
+                                              const std::vector<bool>& accepted) const;
+  std::vector<std::size_t> associate_and_propose(Particle& particle, std::span<const Measurement> measurements,
+                                                 bool proposal, const std::vector<PendingMotion>& pending) const;
+  double new_landmark_log_weight(const State& x, const Measurement& z) const;
+  void map_unassociated(Particle& particle, std::span<const Measurement> measurements,
+                        const std::vector<std::size_t>& match, bool proposal, Transaction& t) const;
   std::vector<std::size_t> associate_in_particle(Particle& particle, State& mean, PoseMatrix& cov,
                                                  std::span<const Measurement> measurements, bool proposal) const;
-  void normalize_and_resample(Transaction& t) const;
+  std::vector<std::size_t> normalize_and_resample(Transaction& t) const;
   PoseEstimate cloud_estimate(const std::vector<Particle>& cloud, const std::vector<PendingMotion>& pending) const;
   PoseEstimate pose_component(const Particle& particle, const std::vector<PendingMotion>& pending) const;
   double point_support(const std::vector<Particle>& cloud, const std::vector<PendingMotion>& pending,

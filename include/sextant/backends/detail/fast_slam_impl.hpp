@@ -214,11 +214,14 @@ double FastSlam<Motion, Sensor, Map>::fold_into_proposal(State& mean, PoseMatrix
   return log_gaussian(in.llt, in.nu);
 }
 
+/// FastSLAM 2.0's Gaussian proposal of one particle's pose, folded from its motion prior and the
+/// accepted observations of known landmarks (kept as Particle::drawn_from, drawn_cov); its weight
+/// factor (eq. 93) is added to the particle. Nothing is drawn: the weight depends on the particle
+/// before the draw, which is what lets update() resample first (draw_from_proposal).
 template <class Motion, class Sensor, template <class> class Map>
-auto FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const PoseEstimate& prior,
-                                                       std::span<const ObservationType> known,
-                                                       const std::vector<bool>& accepted,
-                                                       std::mt19937_64& rng) const -> std::vector<Outcome> {
+auto FastSlam<Motion, Sensor, Map>::propose_v2(Particle& particle, const PoseEstimate& prior,
+                                               std::span<const ObservationType> known,
+                                               const std::vector<bool>& accepted) const -> std::vector<Outcome> {
   State mean = prior.mean;
   PoseMatrix cov = prior.cov;
   std::vector<Outcome> outcomes(known.size(), Outcome::used);
@@ -236,10 +239,21 @@ auto FastSlam<Motion, Sensor, Map>::sample_v2_proposal(Particle& particle, const
     particle.log_weight += fold_into_proposal(mean, cov, proposal_innovation(std::move(*prediction), cov, L, known[i].z));
   }
   if (!std::isfinite(particle.log_weight)) throw numerical_error("FastSLAM 2.0 proposal weight is not finite");
-  draw_into(particle, {mean, cov}, rng);
-  particle.drawn_from = mean;
-  particle.drawn_cov = cov;
+  particle.drawn_from = std::move(mean);
+  particle.drawn_cov = std::move(cov);
   return outcomes;
+}
+
+/// A particle's pose drawn from its proposal, then each landmark its proposal used updated from the
+/// drawn pose (eqs. 75-78); one that is behind the camera from there becomes unusable.
+template <class Motion, class Sensor, template <class> class Map>
+void FastSlam<Motion, Sensor, Map>::draw_from_proposal(Particle& particle, std::span<const ObservationType> known,
+                                                       std::vector<Outcome>& outcomes, std::mt19937_64& rng) const {
+  draw_into(particle, {particle.drawn_from, particle.drawn_cov}, rng);
+  for (std::size_t i = 0; i < known.size(); ++i)
+    if (outcomes[i] == Outcome::used &&
+        update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false).outcome == Outcome::unusable)
+      outcomes[i] = Outcome::unusable;
 }
 
 /// The gate on the cloud (docs/results/mrclam.md, "FastSLAM's gate on the cloud"): an observation
@@ -289,33 +303,23 @@ std::vector<bool> FastSlam<Motion, Sensor, Map>::accepted_by_cloud(const std::ve
   return accepted;
 }
 
-/// One particle's known landmarks: with FastSLAM 2.0 the pose sampled from the proposal, then each
-/// landmark updated from it; with 1.0 each landmark updated and weighed (eq. 85).
+/// One particle's known landmarks without a proposal (FastSLAM 1.0, or 2.0 with no motion pending):
+/// each landmark updated from the particle's pose and weighed (eq. 85).
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::update_known_landmarks(Particle& particle, std::span<const ObservationType> known,
-                                                           const std::vector<bool>& accepted, bool proposal,
-                                                           Transaction& t) const -> std::vector<Outcome> {
+                                                           const std::vector<bool>& accepted) const
+    -> std::vector<Outcome> {
   std::vector<Outcome> outcomes;
-  if (!proposal) {
-    particle.forget_proposal();
-    for (std::size_t i = 0; i < known.size(); ++i) {
-      if (!accepted[i]) {
-        outcomes.push_back(Outcome::gated);
-        continue;
-      }
-      const auto result = update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false);
-      particle.log_weight += result.log_likelihood;
-      outcomes.push_back(result.outcome);
+  particle.forget_proposal();
+  for (std::size_t i = 0; i < known.size(); ++i) {
+    if (!accepted[i]) {
+      outcomes.push_back(Outcome::gated);
+      continue;
     }
-    return outcomes;
+    const auto result = update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false);
+    particle.log_weight += result.log_likelihood;
+    outcomes.push_back(result.outcome);
   }
-  const auto& motion = t.pending.back();
-  outcomes = sample_v2_proposal(particle, motion_gaussian(particle.x, particle.cov, motion.u, motion.dt), known,
-                                accepted, t.rng);
-  for (std::size_t i = 0; i < known.size(); ++i)
-    if (outcomes[i] == Outcome::used &&
-        update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false).outcome == Outcome::unusable)
-      outcomes[i] = Outcome::unusable;  // behind the camera from the sampled pose
   return outcomes;
 }
 
@@ -329,23 +333,39 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
   const bool proposal = options_.version == FastSlamVersion::v2 && !t.pending.empty();
   const std::vector<bool> accepted = accepted_by_cloud(t.particles, known, proposal ? &t.pending.back() : nullptr);
   std::vector<std::vector<Outcome>> outcomes(t.particles.size());
-  for (std::size_t n = 0; n < t.particles.size(); ++n)
-    outcomes[n] = update_known_landmarks(t.particles[n], known, accepted, proposal, t);
+  for (std::size_t n = 0; n < t.particles.size(); ++n) {
+    Particle& particle = t.particles[n];
+    if (!proposal) {
+      outcomes[n] = update_known_landmarks(particle, known, accepted);
+      continue;
+    }
+    const auto& motion = t.pending.back();
+    outcomes[n] = propose_v2(particle, motion_gaussian(particle.x, particle.cov, motion.u, motion.dt), known, accepted);
+  }
+  t.pending.clear();
+  const std::size_t best = best_particle(t.particles);
+  std::vector<Outcome> reported = outcomes[best];
+  const auto parents = normalize_and_resample(t);  // with the frame as the particles were drawn in (point_support)
+  // FastSLAM 2.0's weight does not depend on the draw, so the cloud was resampled first and each
+  // copy of a particle draws its own pose (the fully adapted order; Pitt and Shephard, JASA 1999).
+  const auto copy_of_best = static_cast<std::size_t>(std::find(parents.begin(), parents.end(), best) - parents.begin());
+  for (std::size_t n = 0; proposal && n < t.particles.size(); ++n) {
+    std::vector<Outcome> drawn = outcomes[parents[n]];
+    draw_from_proposal(t.particles[n], known, drawn, t.rng);
+    if (n == copy_of_best) reported = std::move(drawn);
+  }
   UpdateResult result;
   const auto added = add_new_landmarks(t.particles, fresh, result.unusable);
-  t.pending.clear();
-  const auto& best = outcomes[best_particle(t.particles)];
   std::size_t known_unusable = 0;
   for (std::size_t i = 0; i < known.size(); ++i) {
-    if (best[i] == Outcome::gated) result.rejected.push_back(known[i].landmark_id);
-    if (best[i] == Outcome::unusable) {
+    if (reported[i] == Outcome::gated) result.rejected.push_back(known[i].landmark_id);
+    if (reported[i] == Outcome::unusable) {
       result.unusable.push_back(known[i].landmark_id);
       ++known_unusable;
     }
   }
   result.corrected = known.size() - result.rejected.size() - known_unusable;
   result.initialized = added.size();
-  normalize_and_resample(t);  // with the frame as the particles were drawn in (point_support)
   fix_frame_if_mapped(t);
   auto index = index_;
   auto id_of_index = id_of_index_;
@@ -399,13 +419,18 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
   for (const auto& z : measurements) require_finite(z, "unassociated measurement");
   Transaction t = begin();
   const bool proposal = options_.version == FastSlamVersion::v2 && !t.pending.empty();
-  std::vector<std::size_t> started(t.particles.size(), 0);
+  std::vector<std::vector<std::size_t>> match(t.particles.size());
   for (std::size_t n = 0; n < t.particles.size(); ++n)
-    started[n] = update_particle_unassociated(t.particles[n], measurements, proposal, t);
+    match[n] = associate_and_propose(t.particles[n], measurements, proposal, t.pending);
   t.pending.clear();
+  const auto& chosen = match[best_particle(t.particles)];
+  const auto initialized = static_cast<std::size_t>(std::count(chosen.begin(), chosen.end(), kNewLandmark));
+  for (std::size_t n = 0; !proposal && n < t.particles.size(); ++n)  // weighed by the updates themselves
+    map_unassociated(t.particles[n], measurements, match[n], false, t);
+  const auto parents = normalize_and_resample(t);  // with the frame as the particles were drawn in (point_support)
+  for (std::size_t n = 0; proposal && n < t.particles.size(); ++n)  // each copy draws its own pose, as in update()
+    map_unassociated(t.particles[n], measurements, match[parents[n]], true, t);
   t.next_unassociated_id += measurements.size();
-  const std::size_t initialized = started[best_particle(t.particles)];
-  normalize_and_resample(t);  // with the frame as the particles were drawn in (point_support)
   fix_frame_if_mapped(t);
   commit(std::move(t));
   return {measurements.size() - initialized, initialized, {}, {}};
@@ -413,9 +438,9 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
 
 /// Normalizes the log weights (log-sum-exp), keeps the weighted cloud as the pose estimate, and
 /// resamples by the low-variance sampler (§3.7.4) when the effective sample size falls below the
-/// threshold.
+/// threshold. Returns each particle's parent in the cloud before (itself when none was resampled).
 template <class Motion, class Sensor, template <class> class Map>
-void FastSlam<Motion, Sensor, Map>::normalize_and_resample(Transaction& t) const {
+std::vector<std::size_t> FastSlam<Motion, Sensor, Map>::normalize_and_resample(Transaction& t) const {
   auto& particles = t.particles;
   const double max_log = particles[best_particle(particles)].log_weight;
   if (!std::isfinite(max_log)) throw numerical_error("FastSLAM particle weights are not finite");
@@ -427,7 +452,9 @@ void FastSlam<Motion, Sensor, Map>::normalize_and_resample(Transaction& t) const
   t.support = point_support(particles, t.pending, t.frame_fixed);
   const double n = static_cast<double>(particles.size());
   const auto w = normalized_weights(particles);
-  if (effective_sample_size_of(w) >= options_.resample_threshold * n) return;
+  std::vector<std::size_t> parents(particles.size());
+  std::iota(parents.begin(), parents.end(), std::size_t{0});
+  if (effective_sample_size_of(w) >= options_.resample_threshold * n) return parents;
   std::vector<Particle> resampled;
   resampled.reserve(particles.size());
   const double step = 1.0 / n;
@@ -437,9 +464,11 @@ void FastSlam<Motion, Sensor, Map>::normalize_and_resample(Transaction& t) const
     while (u > cumulative && i + 1 < w.size()) cumulative += w[++i];
     resampled.push_back(particles[i]);  // O(1) map copy with PersistentArray
     resampled.back().log_weight = -std::log(n);
+    parents[m] = i;
   }
   particles = std::move(resampled);
   t.resampled = true;
+  return parents;
 }
 
 template <class Motion, class Sensor, template <class> class Map>
@@ -667,27 +696,49 @@ std::vector<std::size_t> FastSlam<Motion, Sensor, Map>::associate_in_particle(Pa
   return match;
 }
 
-/// One particle's step of update_unassociated: its pose over the pending motions (sampled, or with
-/// FastSLAM 2.0 the Gaussian proposal sampled after association), each measurement's landmark
-/// updated or started. Returns how many landmarks it started.
+/// One particle's association in update_unassociated: its pose over the pending motions and each
+/// measurement's landmark (kNewLandmark: start one). With FastSLAM 2.0 the associated measurements
+/// shape the Gaussian proposal (Particle::drawn_from, drawn_cov) and weigh on the particle, and so
+/// does each new landmark, as a measurement on the new-landmark gate's edge (the p0 of Montemerlo
+/// et al.); none of that depends on the pose drawn later (map_unassociated).
 template <class Motion, class Sensor, template <class> class Map>
-std::size_t FastSlam<Motion, Sensor, Map>::update_particle_unassociated(Particle& particle,
-                                                                        std::span<const Measurement> measurements,
-                                                                        bool proposal, Transaction& t) const {
+std::vector<std::size_t> FastSlam<Motion, Sensor, Map>::associate_and_propose(
+    Particle& particle, std::span<const Measurement> measurements, bool proposal,
+    const std::vector<PendingMotion>& pending) const {
   // Only FastSLAM 2.0 leaves motion pending (1.0 samples it in predict), so the prior is the
   // particle's point (tail Gaussian) without the proposal.
   PoseEstimate prior{particle.x, particle.cov};
-  for (const auto& motion : t.pending) prior = motion_gaussian(prior.mean, prior.cov, motion.u, motion.dt);
+  for (const auto& motion : pending) prior = motion_gaussian(prior.mean, prior.cov, motion.u, motion.dt);
   auto [mean, cov] = prior;
   const auto match = associate_in_particle(particle, mean, cov, measurements, proposal);
-  if (proposal) {
-    draw_into(particle, {mean, cov}, t.rng);
-    particle.drawn_from = mean;
-    particle.drawn_cov = cov;
-  } else {
+  if (!proposal) {
     particle.forget_proposal();
+    return match;
   }
-  std::size_t started = 0;
+  for (std::size_t i = 0; i < measurements.size(); ++i)
+    if (match[i] == kNewLandmark) particle.log_weight += new_landmark_log_weight(mean, measurements[i]);
+  particle.drawn_from = std::move(mean);
+  particle.drawn_cov = std::move(cov);
+  return match;
+}
+
+/// log N(0; 0, Q) - new_landmark_nis / 2: what a new landmark weighs, as a measurement on the
+/// new-landmark gate's edge, with the measurement noise at pose x.
+template <class Motion, class Sensor, template <class> class Map>
+double FastSlam<Motion, Sensor, Map>::new_landmark_log_weight(const State& x, const Measurement& z) const {
+  const auto init = initialize_landmark(sensor_, x, z, LandmarkId{0});
+  return log_gaussian(cholesky_or_throw(init.Q, "measurement noise"), Eigen::Matrix<double, Z, 1>::Zero().eval()) -
+         0.5 * options_.new_landmark_nis;
+}
+
+/// One particle's landmarks in update_unassociated: with FastSLAM 2.0 its pose drawn from the
+/// proposal first; each associated landmark updated from the pose (weighing on the particle
+/// without a proposal), each other measurement starting a landmark with id next_unassociated_id + i.
+template <class Motion, class Sensor, template <class> class Map>
+void FastSlam<Motion, Sensor, Map>::map_unassociated(Particle& particle, std::span<const Measurement> measurements,
+                                                     const std::vector<std::size_t>& match, bool proposal,
+                                                     Transaction& t) const {
+  if (proposal) draw_into(particle, {particle.drawn_from, particle.drawn_cov}, t.rng);
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     if (match[i] != kNewLandmark) {
       const double log_likelihood = update_landmark(particle, match[i], measurements[i], true).log_likelihood;
@@ -697,13 +748,8 @@ std::size_t FastSlam<Motion, Sensor, Map>::update_particle_unassociated(Particle
     const LandmarkId id = t.next_unassociated_id + i;
     const auto init = initialize_landmark(sensor_, particle.x, measurements[i], id);
     particle.unassociated.push_back({init.m, symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose()), true, id});
-    ++started;
-    // A new landmark weighs as a measurement on the gate's edge (the p0 of Montemerlo et al.).
-    particle.log_weight += log_gaussian(cholesky_or_throw(init.Q, "measurement noise"),
-                                                Eigen::Matrix<double, Z, 1>::Zero().eval()) -
-                           0.5 * options_.new_landmark_nis;
+    if (!proposal) particle.log_weight += new_landmark_log_weight(particle.x, measurements[i]);
   }
-  return started;
 }
 
 }  // namespace sextant
