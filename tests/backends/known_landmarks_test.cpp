@@ -1,14 +1,17 @@
-// EkfSlam::add_landmark: a landmark known before it is seen (a surveyed map) enters with its own
-// mean and covariance, uncorrelated with the robot and the map, and the next update is the Kalman
-// update of that joint Gaussian; bad input leaves the filter as it was.
+// EkfSlam::add_landmark and SeifSlam::add_landmark: a landmark known before it is seen (a surveyed
+// map) enters with its own mean and covariance, uncorrelated with the robot and the map, and the next
+// update is the Kalman update of that joint Gaussian (SEIF without sparsification: the same); bad
+// input leaves the filter as it was.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
 
 #include "sextant/backends/ekf_slam.hpp"
+#include "sextant/backends/seif_slam.hpp"
 #include "sextant/models/range_bearing_2d.hpp"
 #include "sextant/models/se2_odometry.hpp"
 
@@ -16,6 +19,7 @@ namespace sextant {
 namespace {
 
 using Ekf = EkfSlam<Se2Odometry, RangeBearing2D>;
+using Seif = SeifSlam<Se2Odometry, RangeBearing2D>;
 
 RangeBearing2D sensor() {
   RangeBearing2D out;
@@ -28,12 +32,13 @@ const LandmarkEstimate<2> kSurveyed{7, Eigen::Vector2d(2.0, 1.0), (Eigen::Matrix
 
 /// A filter after one step of odometry with a map of one landmark seen before (id 3), so that the
 /// robot is correlated with the map when the known landmark comes in.
-Ekf filter_with_a_map() {
-  Ekf ekf(Se2Odometry{}, sensor(), kStart);
-  ekf.update(std::vector<Observation<Eigen::Vector2d>>{{3, Eigen::Vector2d(1.5, -0.4)}});
-  ekf.predict({Eigen::Vector3d(0.5, 0.1, 0.05), Eigen::Vector3d(0.01, 0.01, 0.002).asDiagonal()}, 1.0);
-  return ekf;
+template <class Filter>
+Filter with_a_map(Filter filter) {
+  filter.update(std::vector<Observation<Eigen::Vector2d>>{{3, Eigen::Vector2d(1.5, -0.4)}});
+  filter.predict({Eigen::Vector3d(0.5, 0.1, 0.05), Eigen::Vector3d(0.01, 0.01, 0.002).asDiagonal()}, 1.0);
+  return filter;
 }
+Ekf filter_with_a_map() { return with_a_map(Ekf(Se2Odometry{}, sensor(), kStart)); }
 
 TEST(KnownLandmarks, EnterWithTheirCovarianceAndNoCorrelation) {
   Ekf ekf = filter_with_a_map();
@@ -116,6 +121,69 @@ TEST(KnownLandmarks, BadOnesAreRefusedAndTheFilterStaysAsItWas) {
   ekf.add_landmark(kSurveyed);
   EXPECT_THROW(ekf.add_landmark(kSurveyed), duplicate_landmark_error);
   EXPECT_EQ(ekf.num_landmarks(), 2u);
+}
+
+/// Largest difference between the two filters' pose and landmark means (absolute) and covariances
+/// (relative to the EKF's largest entry).
+double largest_difference(const Ekf& ekf, const Seif& seif) {
+  const auto relative = [](const auto& a, const auto& b) { return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff(); };
+  double out = std::max((seif.pose().mean - ekf.pose().mean).cwiseAbs().maxCoeff(), relative(seif.pose().cov, ekf.pose().cov));
+  for (const auto& landmark : ekf.map()) {
+    const auto other = seif.landmark(landmark.id);
+    out = std::max({out, (other.mean - landmark.mean).cwiseAbs().maxCoeff(), relative(other.cov, landmark.cov)});
+  }
+  return out;
+}
+
+/// SEIF without sparsification is the EKF in information form (thesis §5), so a surveyed landmark,
+/// an information block cov^-1 with no link, must leave it equal to the EKF given the same one, at
+/// once and through the updates that see it. Bound: rounding of the information form's solves over a
+/// few steps (the whole ship run stays within 1e-6, seif_slam_test).
+TEST(KnownLandmarks, SeifWithoutSparsificationTakesThemAsTheEkfDoes) {
+  Ekf ekf = filter_with_a_map();
+  Seif seif = with_a_map(Seif(Se2Odometry{}, sensor(), kStart, {.max_active = 0, .exact_recovery_period = 1}));
+  ASSERT_LT(largest_difference(ekf, seif), 1e-9);
+  ekf.add_landmark(kSurveyed);
+  seif.add_landmark(kSurveyed);
+  ASSERT_TRUE(seif.has_landmark(kSurveyed.id));
+  EXPECT_LT(largest_difference(ekf, seif), 1e-9);
+  const std::vector<Observation<Eigen::Vector2d>> sightings{{kSurveyed.id, Eigen::Vector2d(2.1, 0.35)},
+                                                            {3, Eigen::Vector2d(1.2, -0.5)}};
+  for (int k = 0; k < 3; ++k) {
+    ekf.update(sightings);
+    seif.update(sightings);
+    EXPECT_LT(largest_difference(ekf, seif), 1e-9) << "update " << k;
+    ekf.predict({Eigen::Vector3d(0.05, 0.0, 0.01), Eigen::Vector3d(0.001, 0.001, 0.0002).asDiagonal()}, 1.0);
+    seif.predict({Eigen::Vector3d(0.05, 0.0, 0.01), Eigen::Vector3d(0.001, 0.001, 0.0002).asDiagonal()}, 1.0);
+  }
+  EXPECT_LT(seif.landmark(kSurveyed.id).cov.trace(), kSurveyed.cov.trace());  // the sightings refined it
+}
+
+TEST(KnownLandmarks, SeifRefusesBadOnesAndStaysAsItWas) {
+  Seif seif = with_a_map(Seif(Se2Odometry{}, sensor(), kStart));
+  const auto pose = seif.pose();
+  const auto map = seif.map();
+  auto expect_unchanged = [&] {
+    EXPECT_EQ(seif.pose().mean, pose.mean);
+    EXPECT_EQ(seif.pose().cov, pose.cov);
+    ASSERT_EQ(seif.map().size(), map.size());
+    EXPECT_EQ(seif.map().front().mean, map.front().mean);
+  };
+  LandmarkEstimate<2> bad = kSurveyed;
+  bad.id = 3;  // seen already
+  EXPECT_THROW(seif.add_landmark(bad), duplicate_landmark_error);
+  expect_unchanged();
+  bad = kSurveyed;
+  bad.mean.y() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(seif.add_landmark(bad), invalid_input_error);
+  expect_unchanged();
+  bad = kSurveyed;
+  bad.cov << 0.02, 0.03, 0.03, 0.02;  // symmetric, eigenvalue -0.01
+  EXPECT_THROW(seif.add_landmark(bad), invalid_input_error);
+  expect_unchanged();
+  seif.add_landmark(kSurveyed);
+  EXPECT_THROW(seif.add_landmark(kSurveyed), duplicate_landmark_error);
+  EXPECT_EQ(seif.num_landmarks(), 2u);
 }
 
 }  // namespace

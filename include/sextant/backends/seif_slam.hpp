@@ -148,6 +148,11 @@ class SeifSlam {
   UpdateResult update(std::span<const ObservationType> observations);
   UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }
 
+  /// A landmark known before it is seen (a surveyed map), with its mean and covariance, uncorrelated
+  /// with the robot and the map: its information block is cov^-1 and it has no link (it is not active),
+  /// as EkfSlam::add_landmark's zero cross-covariance. Throws on a non-finite mean, a covariance that
+  /// is not symmetric positive definite, or an id already in the map; the filter is then unchanged.
+  void add_landmark(const LandmarkEstimate<M>& known);
   /// Marginalizes a landmark out of the information form (thesis Appendix C).
   void remove_landmark(LandmarkId id);
 
