@@ -85,42 +85,47 @@ TEST(KnownLandmarks, TheNextUpdateIsTheKalmanUpdateOfTheJointGaussian) {
   EXPECT_LT(ekf.pose().cov.trace(), P.topLeftCorner(3, 3).trace());
 }
 
-TEST(KnownLandmarks, BadOnesAreRefusedAndTheFilterStaysAsItWas) {
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  Ekf ekf = filter_with_a_map();
-  const Eigen::MatrixXd cov = ekf.covariance();
-  const Eigen::Vector3d pose = ekf.pose().mean;
-  auto expect_unchanged = [&] {
-    EXPECT_EQ(ekf.covariance(), cov);
-    EXPECT_EQ(ekf.pose().mean, pose);
-    EXPECT_EQ(ekf.num_landmarks(), 1u);
-  };
+/// Each bad landmark is refused with the error that names it and leaves `filter` as it was
+/// (`expect_unchanged`, over the filter's one seen landmark); then the good one goes in, once.
+template <class Filter, class ExpectUnchanged>
+void expect_bad_ones_refused(Filter& filter, ExpectUnchanged expect_unchanged) {
   LandmarkEstimate<2> bad = kSurveyed;
   bad.id = 3;  // seen already
-  EXPECT_THROW(ekf.add_landmark(bad), duplicate_landmark_error);
+  EXPECT_THROW(filter.add_landmark(bad), duplicate_landmark_error);
   expect_unchanged();
   bad = kSurveyed;
-  bad.mean.x() = nan;
-  EXPECT_THROW(ekf.add_landmark(bad), invalid_input_error);
+  bad.mean.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(filter.add_landmark(bad), invalid_input_error);
   expect_unchanged();
   bad = kSurveyed;
   bad.cov(1, 1) = std::numeric_limits<double>::infinity();
-  EXPECT_THROW(ekf.add_landmark(bad), invalid_input_error);
+  EXPECT_THROW(filter.add_landmark(bad), invalid_input_error);
   expect_unchanged();
   bad = kSurveyed;
   bad.cov(0, 1) = 0.01;  // not symmetric
-  EXPECT_THROW(ekf.add_landmark(bad), invalid_input_error);
+  EXPECT_THROW(filter.add_landmark(bad), invalid_input_error);
   expect_unchanged();
   bad = kSurveyed;
   bad.cov << 0.02, 0.03, 0.03, 0.02;  // symmetric, eigenvalue -0.01
-  EXPECT_THROW(ekf.add_landmark(bad), invalid_input_error);
+  EXPECT_THROW(filter.add_landmark(bad), invalid_input_error);
   expect_unchanged();
   bad.cov.setZero();  // a known landmark still has some uncertainty
-  EXPECT_THROW(ekf.add_landmark(bad), invalid_input_error);
+  EXPECT_THROW(filter.add_landmark(bad), invalid_input_error);
   expect_unchanged();
-  ekf.add_landmark(kSurveyed);
-  EXPECT_THROW(ekf.add_landmark(kSurveyed), duplicate_landmark_error);
-  EXPECT_EQ(ekf.num_landmarks(), 2u);
+  filter.add_landmark(kSurveyed);
+  EXPECT_THROW(filter.add_landmark(kSurveyed), duplicate_landmark_error);
+  EXPECT_EQ(filter.num_landmarks(), 2u);
+}
+
+TEST(KnownLandmarks, BadOnesAreRefusedAndTheFilterStaysAsItWas) {
+  Ekf ekf = filter_with_a_map();
+  const Eigen::MatrixXd cov = ekf.covariance();
+  const Eigen::Vector3d pose = ekf.pose().mean;
+  expect_bad_ones_refused(ekf, [&] {
+    EXPECT_EQ(ekf.covariance(), cov);
+    EXPECT_EQ(ekf.pose().mean, pose);
+    EXPECT_EQ(ekf.num_landmarks(), 1u);
+  });
 }
 
 /// Largest difference between the two filters' pose and landmark means (absolute) and covariances
@@ -163,27 +168,12 @@ TEST(KnownLandmarks, SeifRefusesBadOnesAndStaysAsItWas) {
   Seif seif = with_a_map(Seif(Se2Odometry{}, sensor(), kStart));
   const auto pose = seif.pose();
   const auto map = seif.map();
-  auto expect_unchanged = [&] {
+  expect_bad_ones_refused(seif, [&] {
     EXPECT_EQ(seif.pose().mean, pose.mean);
     EXPECT_EQ(seif.pose().cov, pose.cov);
     ASSERT_EQ(seif.map().size(), map.size());
     EXPECT_EQ(seif.map().front().mean, map.front().mean);
-  };
-  LandmarkEstimate<2> bad = kSurveyed;
-  bad.id = 3;  // seen already
-  EXPECT_THROW(seif.add_landmark(bad), duplicate_landmark_error);
-  expect_unchanged();
-  bad = kSurveyed;
-  bad.mean.y() = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(seif.add_landmark(bad), invalid_input_error);
-  expect_unchanged();
-  bad = kSurveyed;
-  bad.cov << 0.02, 0.03, 0.03, 0.02;  // symmetric, eigenvalue -0.01
-  EXPECT_THROW(seif.add_landmark(bad), invalid_input_error);
-  expect_unchanged();
-  seif.add_landmark(kSurveyed);
-  EXPECT_THROW(seif.add_landmark(kSurveyed), duplicate_landmark_error);
-  EXPECT_EQ(seif.num_landmarks(), 2u);
+  });
 }
 
 }  // namespace
