@@ -12,6 +12,7 @@
 #include <unordered_set>
 
 #include "sextant/core/error.hpp"
+#include "sextant/core/gaussian.hpp"
 #include "sextant/core/observation.hpp"
 
 namespace sextant {
@@ -83,6 +84,16 @@ void require_valid_observations(std::span<const Observation<Measurement>> observ
       throw duplicate_landmark_error("landmark id " + std::to_string(observation.landmark_id) +
                                      " is observed twice in one update");
   }
+}
+
+/// A landmark known before it is seen (add_landmark): a finite mean, a symmetric positive definite
+/// covariance, and an id that is not in the map yet (`in_map`: whether it is).
+template <int M>
+void require_valid_known_landmark(const LandmarkEstimate<M>& known, bool in_map) {
+  const std::string what = "known landmark " + std::to_string(known.id);
+  require_finite(known.mean, what + " mean");
+  require_symmetric_positive_definite<M>(known.cov, what + " covariance");
+  if (in_map) throw duplicate_landmark_error("landmark id " + std::to_string(known.id) + " is already in the map");
 }
 
 }  // namespace sextant

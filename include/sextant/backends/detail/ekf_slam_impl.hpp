@@ -335,10 +335,7 @@ void EkfSlam<Motion, Sensor>::augment(LandmarkId id, const Init& init) {
 
 template <class Motion, class Sensor>
 void EkfSlam<Motion, Sensor>::add_landmark(const LandmarkEstimate<M>& known) {
-  const std::string what = "known landmark " + std::to_string(known.id);
-  require_finite(known.mean, what + " mean");
-  require_symmetric_positive_definite<M>(known.cov, what + " covariance");
-  if (landmarks_.contains(known.id)) throw duplicate_landmark_error("landmark id " + std::to_string(known.id) + " is already in the map");
+  require_valid_known_landmark(known, landmarks_.contains(known.id));
   if (probation_.active()) probation_.candidate().add_landmark(known);  // checked above: cannot throw but bad_alloc
   const Eigen::Index offset = cov_.dim();
   landmarks_.add(known.id, Landmark(known.mean));

@@ -805,14 +805,11 @@ auto SeifSlam<Motion, Sensor>::sparsify(bool active_block_gathered) -> std::opti
 
 template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::add_landmark(const LandmarkEstimate<M>& known) {
-  const std::string what = "known landmark " + std::to_string(known.id);
-  require_finite(known.mean, what + " mean");
-  require_symmetric_positive_definite<M>(known.cov, what + " covariance");
-  if (landmarks_.contains(known.id))
-    throw duplicate_landmark_error("landmark id " + std::to_string(known.id) + " is already in the map");
+  require_valid_known_landmark(known, landmarks_.contains(known.id));
   const Eigen::Matrix<double, M, M> information =
       symmetrized(known.cov.llt().solve(Eigen::Matrix<double, M, M>::Identity()).eval());
-  if (!information.allFinite()) throw numerical_error(what + ": its information (covariance inverse) is not finite");
+  if (!information.allFinite())
+    throw numerical_error("known landmark " + std::to_string(known.id) + ": its information (covariance inverse) is not finite");
   atomically([&] {
     const std::size_t slot = landmarks_.add(known.id, Landmark(known.mean));
     info_.append_landmark();
