@@ -229,9 +229,10 @@ class FastSlam {
                                   const std::vector<bool>& accepted) const;
   void draw_from_proposal(Particle& particle, std::span<const ObservationType> known, std::vector<Outcome>& outcomes,
                           std::mt19937_64& rng) const;
+  std::vector<PoseEstimate> pose_priors(const std::vector<Particle>& particles, const PendingMotion* motion) const;
   /// Per observation of a known landmark: whether the gate on the cloud lets it through.
-  std::vector<bool> accepted_by_cloud(const std::vector<Particle>& particles, std::span<const ObservationType> known,
-                                      const PendingMotion* motion) const;
+  std::vector<bool> accepted_by_cloud(const std::vector<Particle>& particles, const std::vector<PoseEstimate>& poses,
+                                      std::span<const ObservationType> known) const;
   std::vector<Outcome> update_known_landmarks(Particle& particle, std::span<const ObservationType> known,
                                               const std::vector<bool>& accepted) const;
   std::vector<std::size_t> associate_and_propose(Particle& particle, std::span<const Measurement> measurements,

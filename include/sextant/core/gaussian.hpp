@@ -46,6 +46,19 @@ Eigen::LLT<typename Derived::PlainObject> cholesky_or_throw(const Eigen::MatrixB
   return llt;
 }
 
+/// A^-1 of a symmetric positive definite A from its Cholesky factor, made exactly symmetric.
+template <class Matrix>
+Matrix inverse_from_cholesky(const Eigen::LLT<Matrix>& llt) {
+  const Matrix inverse = llt.solve(Matrix::Identity(llt.rows(), llt.cols()));
+  return symmetrized(inverse);
+}
+
+/// A^-1 of a symmetric matrix that must be positive definite (cholesky_or_throw names `what`).
+template <class Derived>
+typename Derived::PlainObject inverse_of_spd_or_throw(const Eigen::MatrixBase<Derived>& a, const std::string& what) {
+  return inverse_from_cholesky(cholesky_or_throw(a, what));
+}
+
 /// Whether the lower triangle of a square matrix (all that a Cholesky factorization reads) is finite.
 template <class Derived>
 bool lower_triangle_is_finite(const Eigen::MatrixBase<Derived>& a) {

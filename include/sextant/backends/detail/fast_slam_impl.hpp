@@ -256,6 +256,19 @@ void FastSlam<Motion, Sensor, Map>::draw_from_proposal(Particle& particle, std::
       outcomes[i] = Outcome::unusable;
 }
 
+/// Each particle's pose before this step's measurements: its motion prior when a FastSLAM 2.0 motion
+/// is pending (the proposal's start, computed once for the gate and the proposal), else its pose.
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::pose_priors(const std::vector<Particle>& particles, const PendingMotion* motion) const
+    -> std::vector<PoseEstimate> {
+  std::vector<PoseEstimate> poses;
+  poses.reserve(particles.size());
+  for (const auto& particle : particles)
+    poses.push_back(motion ? motion_gaussian(particle.x, particle.cov, motion->u, motion->dt)
+                           : PoseEstimate{particle.x, particle.cov});
+  return poses;
+}
+
 /// The gate on the cloud (docs/results/mrclam.md, "FastSLAM's gate on the cloud"): an observation
 /// of a known landmark is an outlier when it is one for the filter's predictive distribution, the
 /// weighted mixture over particles of N(h(x_n, m_n), S_n) with S_n = H_x C_n H_x^T + H_m Sigma_m H_m^T
@@ -266,16 +279,11 @@ void FastSlam<Motion, Sensor, Map>::draw_from_proposal(Particle& particle, std::
 /// Particles that cannot predict it are left out; all true with the gate off.
 template <class Motion, class Sensor, template <class> class Map>
 std::vector<bool> FastSlam<Motion, Sensor, Map>::accepted_by_cloud(const std::vector<Particle>& particles,
-                                                                   std::span<const ObservationType> known,
-                                                                   const PendingMotion* motion) const {
+                                                                   const std::vector<PoseEstimate>& poses,
+                                                                   std::span<const ObservationType> known) const {
   std::vector<bool> accepted(known.size(), true);
   if (!gate_.on() || known.empty()) return accepted;
   const auto w = normalized_weights(particles);
-  std::vector<PoseEstimate> poses;
-  poses.reserve(particles.size());
-  for (const auto& particle : particles)
-    poses.push_back(motion ? motion_gaussian(particle.x, particle.cov, motion->u, motion->dt)
-                           : PoseEstimate{particle.x, particle.cov});
   std::vector<Eigen::Matrix<double, Z, 1>> nus(particles.size());
   std::vector<Eigen::Matrix<double, Z, Z>> covs(particles.size());
   for (std::size_t i = 0; i < known.size(); ++i) {
@@ -331,17 +339,12 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
   const auto [known, fresh] = split_known_and_new(index_, observations);
   Transaction t = begin();
   const bool proposal = options_.version == FastSlamVersion::v2 && !t.pending.empty();
-  const std::vector<bool> accepted = accepted_by_cloud(t.particles, known, proposal ? &t.pending.back() : nullptr);
+  const std::vector<PoseEstimate> priors = pose_priors(t.particles, proposal ? &t.pending.back() : nullptr);
+  const std::vector<bool> accepted = accepted_by_cloud(t.particles, priors, known);
   std::vector<std::vector<Outcome>> outcomes(t.particles.size());
-  for (std::size_t n = 0; n < t.particles.size(); ++n) {
-    Particle& particle = t.particles[n];
-    if (!proposal) {
-      outcomes[n] = update_known_landmarks(particle, known, accepted);
-      continue;
-    }
-    const auto& motion = t.pending.back();
-    outcomes[n] = propose_v2(particle, motion_gaussian(particle.x, particle.cov, motion.u, motion.dt), known, accepted);
-  }
+  for (std::size_t n = 0; n < t.particles.size(); ++n)
+    outcomes[n] = proposal ? propose_v2(t.particles[n], priors[n], known, accepted)
+                           : update_known_landmarks(t.particles[n], known, accepted);
   t.pending.clear();
   const std::size_t best = best_particle(t.particles);
   std::vector<Outcome> reported = outcomes[best];

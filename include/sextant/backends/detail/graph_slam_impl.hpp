@@ -59,8 +59,7 @@ template <class Motion, class Sensor>
 GraphSlam<Motion, Sensor>::GraphSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, GraphOptions options)
     : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), prior_(prior), newest_cov_(prior.cov) {
   if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
-  prior_information_ = symmetrized(
-      cholesky_or_throw(prior.cov, "prior covariance").solve(Eigen::Matrix<double, X, X>::Identity()));
+  prior_information_ = inverse_of_spd_or_throw(prior.cov, "prior covariance");
   if (options_.max_iterations < 1 || options_.window_iterations < 1)
     throw invalid_input_error("GraphOptions: max_iterations and window_iterations must be >= 1");
   if (!(options_.relinearize_threshold > 0.0) || !std::isfinite(options_.relinearize_threshold))

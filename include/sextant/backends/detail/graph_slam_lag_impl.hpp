@@ -246,9 +246,8 @@ void GraphSlam<Motion, Sensor>::slide_window(LagPlan& plan, const std::vector<st
     if (options_.reuse_retired_marginals)  // otherwise a landmark seen again starts from its window
       for (std::size_t slot : leaving) {
         const Eigen::Matrix<double, M, M> cov = symmetrized(solved.landmark_covariance(sys, sys.landmark_at.at(slot)));
-        const Eigen::Matrix<double, M, M> information = cholesky_or_throw(cov, "marginal covariance of landmark " + std::to_string(landmarks_.id_at(slot)))
-                                     .solve(Eigen::Matrix<double, M, M>::Identity());
-        plan.window.retired[landmarks_.id_at(slot)] = {at.landmark(slot), symmetrized(information)};
+        plan.window.retired[landmarks_.id_at(slot)] = {
+            at.landmark(slot), inverse_of_spd_or_throw(cov, "marginal covariance of landmark " + std::to_string(landmarks_.id_at(slot)))};
       }
     plan.window.prior = std::move(prior);
     plan.window.seen_from[p].clear();

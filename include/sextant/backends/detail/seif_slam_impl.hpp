@@ -24,8 +24,7 @@ SeifSlam<Motion, Sensor>::SeifSlam(Motion motion, Sensor sensor, const PoseEstim
     : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), x_(prior.mean), propagated_(prior.mean) {
   require_constrainable<Space, Landmark>(options_.observability_constraints);
   if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
-  const auto llt = cholesky_or_throw(prior.cov, "prior covariance");
-  info_.robot() = symmetrized(llt.solve(Eigen::Matrix<double, X, X>::Identity()));
+  info_.robot() = inverse_of_spd_or_throw(prior.cov, "prior covariance");
   if (!(options_.relocalization_min_information >= 0.0) || !std::isfinite(options_.relocalization_min_information))
     throw invalid_input_error("SeifOptions: relocalization_min_information must be finite and >= 0");
   if (options_.mean_recovery_sweeps < 0 || options_.exact_recovery_period < 0)
@@ -53,7 +52,7 @@ Eigen::MatrixXd SeifSlam<Motion, Sensor>::relocalized_tail_information(const Pos
   const Eigen::LLT<Eigen::MatrixXd> llt(symmetrized(cov));
   if (llt.info() != Eigen::Success)
     throw invalid_input_error("SeifOptions: relocalization tail covariance is not positive definite");
-  return symmetrized(Eigen::MatrixXd(llt.solve(Eigen::MatrixXd::Identity(T, T))));
+  return inverse_from_cholesky(llt);
 }
 
 /// Thesis eqs. (20)-(26) in error-state form, with Phi = G^-T Omega G^-1 and
@@ -145,9 +144,8 @@ auto SeifSlam<Motion, Sensor>::new_landmark(const ObservationType& observation, 
   if (!initialized) return std::nullopt;
   const Init& init = *initialized;
   const Eigen::Matrix<double, M, M> C = symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose());
-  const auto llt = cholesky_or_throw(
+  const Eigen::Matrix<double, M, M> W = inverse_of_spd_or_throw(
       C, "covariance J_m_z Q J_m_z^T of new landmark " + std::to_string(observation.landmark_id));
-  const Eigen::Matrix<double, M, M> W = symmetrized(llt.solve(Eigen::Matrix<double, M, M>::Identity()));
   return NewLandmark{observation.landmark_id, init.m, symmetrized(init.J_m_x.transpose() * W * init.J_m_x),
                      -init.J_m_x.transpose() * W, W};
 }
@@ -806,8 +804,7 @@ auto SeifSlam<Motion, Sensor>::sparsify(bool active_block_gathered) -> std::opti
 template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::add_landmark(const LandmarkEstimate<M>& known) {
   require_valid_known_landmark(known, landmarks_.contains(known.id));
-  const Eigen::Matrix<double, M, M> information =
-      symmetrized(known.cov.llt().solve(Eigen::Matrix<double, M, M>::Identity()).eval());
+  const Eigen::Matrix<double, M, M> information = inverse_from_cholesky(known.cov.llt());
   if (!information.allFinite())
     throw numerical_error("known landmark " + std::to_string(known.id) + ": its information (covariance inverse) is not finite");
   atomically([&] {
