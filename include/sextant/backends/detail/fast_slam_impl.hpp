@@ -339,7 +339,10 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
   const auto [known, fresh] = split_known_and_new(index_, observations);
   Transaction t = begin();
   const bool proposal = options_.version == FastSlamVersion::v2 && !t.pending.empty();
-  const std::vector<PoseEstimate> priors = pose_priors(t.particles, proposal ? &t.pending.back() : nullptr);
+  // The priors feed the proposal and the gate on the cloud; FastSLAM 1.0 ungated needs neither.
+  const std::vector<PoseEstimate> priors = proposal || gate_.on()
+                                               ? pose_priors(t.particles, proposal ? &t.pending.back() : nullptr)
+                                               : std::vector<PoseEstimate>{};
   const std::vector<bool> accepted = accepted_by_cloud(t.particles, priors, known);
   std::vector<std::vector<Outcome>> outcomes(t.particles.size());
   for (std::size_t n = 0; n < t.particles.size(); ++n)
