@@ -52,7 +52,7 @@ case "$mode" in
   test-sanitize)
     build=${SEXTANT_SANITIZE_BUILD_DIR:-build-sanitize}
     cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DCMAKE_CXX_COMPILER=clang++ \
-          -DSEXTANT_SANITIZE=address,undefined \
+          -DSEXTANT_SANITIZE=address,undefined -DSEXTANT_QUICK_TEST_BUILD=ON \
           -DSEXTANT_REQUIRE_ALL_DEPENDENCIES=ON -DSEXTANT_BUILD_TESTS=ON -DSEXTANT_BUILD_EXAMPLES=OFF \
           -DSEXTANT_BUILD_BENCHMARKS=OFF >/dev/null
     build_targets sextant_sanitized_tests

@@ -11,7 +11,6 @@
 
 #include "sextant/eval/runner.hpp"
 #include "sextant/models/beacon_ship_2d.hpp"
-#include "sextant/models/stereo_imu_se3.hpp"
 #include "sextant/sim/ship_2d.hpp"
 #include "support/batch_least_squares.hpp"
 #include "support/constant_velocity_point.hpp"
@@ -526,13 +525,10 @@ TEST(FastSlam, RejectsBadOptions) {
 
 TEST(FastSlam, NewLandmarkThresholdFollowsTheMeasurementDimension) {
   // The default is the chi-square quantile at 0.9999 with as many degrees of freedom as the
-  // measurement has: 2 for the ship's offsets, 3 for a stereo point, 4 for stereo pixels.
+  // measurement has: 2 for the ship's offsets (4 for stereo pixels: stereo_vi_test).
   const Gaussian<Eigen::Vector2d, 2> prior{Eigen::Vector2d::Zero(), Eigen::Matrix2d::Identity()};
   EXPECT_DOUBLE_EQ((Fast{BeaconShip2D{}, BeaconOffset2D{}, prior}.options().new_landmark_nis), chi_square_quantile(2, 0.9999));
   EXPECT_NEAR(chi_square_quantile(2, 0.9999), 18.42, 0.005);
-  const Gaussian<Eigen::Matrix4d, 6> pose{Eigen::Matrix4d::Identity(), se3::Matrix6d::Identity()};
-  const FastSlam<ImuVelocitySe3, StereoPixelsSe3> stereo(ImuVelocitySe3{}, StereoPixelsSe3{}, pose);
-  EXPECT_DOUBLE_EQ(stereo.options().new_landmark_nis, chi_square_quantile(4, 0.9999));
   EXPECT_EQ((Fast{BeaconShip2D{}, BeaconOffset2D{}, prior, {.new_landmark_nis = 9.0}}.options().new_landmark_nis), 9.0);
 }
 

@@ -51,6 +51,15 @@ RunScores ekf_run(std::uint64_t seed) {
   return out;
 }
 
+TEST(StereoVi, FastSlamNewLandmarkThresholdIsTheQuantileForFourPixelCoordinates) {
+  // The default is the chi-square quantile at 0.9999 with as many degrees of freedom as the
+  // measurement has (fast_slam_test checks the ship's 2): stereo pixels have 4.
+  const Gaussian<Eigen::Matrix4d, 6> pose{Eigen::Matrix4d::Identity(), se3::Matrix6d::Identity()};
+  const FastSlam<ImuVelocitySe3, StereoPixelsSe3> stereo(ImuVelocitySe3{}, StereoPixelsSe3{}, pose);
+  EXPECT_DOUBLE_EQ(stereo.options().new_landmark_nis, chi_square_quantile(4, 0.9999));
+  EXPECT_NEAR(chi_square_quantile(4, 0.9999), 23.51, 0.005);
+}
+
 TEST(StereoVi, EkfBeatsDeadReckoningAndItsPoseAneesOverTwentySeedsLiesInsideItsInterval) {
   const auto runs = eval::monte_carlo(20, 1, ekf_run);
   std::vector<double> anees;
