@@ -5,7 +5,8 @@
 #                       kf-slam demo rawlogs, comparison table
 #   ./run.sh test       the test suite (ctest; tests labelled 'slow' are left out: ./run.sh test-slow runs them)
 #   ./run.sh test-sanitize  the back-end, reader and model tests built by clang with AddressSanitizer +
-#                       UndefinedBehaviorSanitizer (-O1, any report stops the test) in build-sanitize/
+#                       UndefinedBehaviorSanitizer (back-ends -O1, most test units -O0, any report stops
+#                       the test) in build-sanitize/
 #   ./run.sh test-tsan  the thread-safety tests (concurrent reads, Monte Carlo threads) under ThreadSanitizer
 #   ./run.sh fuzz [s]   every reader's libFuzzer target (clang, ASan + UBSan) for s seconds each
 #                       (default 60) in build-fuzz/, seeds from ../shared/data and MRPT's demo files
