@@ -14,6 +14,7 @@
 #include "sextant/vision/features.hpp"
 #include "sextant/vision/gray_image_view.hpp"
 #include "sextant/vision/row_search_matching.hpp"
+#include "sextant/vision/stereo_front_end.hpp"
 #include "sextant/vision/stereo_matching.hpp"
 #include "sextant/vision/stereo_triangulation.hpp"
 
@@ -143,6 +144,51 @@ TEST(StereoFrontEnd, RowSearchMatchesAreRightAndTheirDepthAsGoodAsDetectingBothI
   EXPECT_GE(fewest, 120u);
   EXPECT_GE(precision, 0.99);
   EXPECT_LE(median(search_depth), median(detect_depth));
+}
+
+/// The floor's bound from the sensor model it protects: at the significant disparity of k standard
+/// deviations, PointInCamera3D's first-order depth standard deviation is the depth over k.
+TEST(StereoFrontEnd, TheSignificantDisparityIsWhereTheDepthIsKnownToItsStatedShare) {
+  const StereoPointNoise noise;  // 0.5 px, f = 600 px, b = 0.1 m: the rendered globe's
+  for (const double k : {1.0, 2.0, 3.0}) {
+    const double d = significant_disparity(noise.pixel_sigma, k);
+    const double z = noise.focal_px * noise.baseline / d;
+    const double depth_sigma = std::sqrt(noise.covariance(Eigen::Vector3d(0.0, 0.0, z))(2, 2));
+    EXPECT_NEAR(k * depth_sigma / z, 1.0, 1e-12) << k;
+  }
+  EXPECT_NEAR(significant_disparity(0.5, 2.0), std::sqrt(2.0), 1e-15);
+}
+
+/// FrontEndOptions::min_disparity drops exactly the matches below it, counted, and leaves the others
+/// (points, descriptors, order) as the front-end without a floor gives them; a floor that is not a
+/// finite non-negative number is refused.
+TEST(StereoFrontEnd, MatchesBelowTheDisparityFloorAreDroppedAndCounted) {
+  const RenderedPair pair;
+  StereoFrontEnd all(pair.rig);
+  const StereoFrame every = all.process(as_mat(pair.images.left), as_mat(pair.images.right));
+  ASSERT_GT(every.features.size(), 10u);
+  std::vector<double> disparities;
+  for (const auto& f : every.features) disparities.push_back(f.left_px.x() - f.right_px.x());
+  std::vector<double> sorted = disparities;
+  std::sort(sorted.begin(), sorted.end());
+  const double floor = sorted[sorted.size() / 2];  // half the frame's matches below it
+  StereoFrontEnd floored(pair.rig, {.min_disparity = floor});
+  const StereoFrame kept = floored.process(as_mat(pair.images.left), as_mat(pair.images.right));
+  EXPECT_EQ(every.below_min_disparity, 0u);
+  EXPECT_GT(kept.below_min_disparity, 0u);
+  EXPECT_EQ(kept.features.size() + kept.below_min_disparity, every.features.size());
+  ASSERT_EQ(kept.descriptors.rows, static_cast<int>(kept.features.size()));
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < every.features.size(); ++i) {
+    if (disparities[i] < floor) continue;
+    ASSERT_LT(k, kept.features.size());
+    EXPECT_EQ(kept.features[k].point, every.features[i].point);
+    EXPECT_EQ(cv::norm(kept.descriptors.row(static_cast<int>(k)), every.descriptors.row(static_cast<int>(i)), cv::NORM_L1), 0.0);
+    ++k;
+  }
+  EXPECT_EQ(k, kept.features.size());
+  for (const double bad : {-1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()})
+    EXPECT_THROW(StereoFrontEnd(pair.rig, {.min_disparity = bad}), invalid_input_error) << bad;
 }
 
 TEST(StereoFrontEnd, AFlatImageHasNoFeaturesAndAnEmptyOneIsAnError) {

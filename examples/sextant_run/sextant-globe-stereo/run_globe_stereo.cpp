@@ -35,6 +35,8 @@ using Observations = std::vector<Observation<Eigen::Vector3d>>;
 /// Sums over the frames of a run: the front-end's figures and the time per stage.
 struct FrontEndTotals {
   std::size_t frames = 0, left_keypoints = 0, stereo_matches = 0, observations = 0, associated = 0, created = 0;
+  std::size_t below_min_disparity = 0;
+  double min_disparity = 0.0;  ///< px, the front-end's floor
   vision::TrackerTimes times;
   double render = 0.0;
 
@@ -42,6 +44,7 @@ struct FrontEndTotals {
     ++frames;
     left_keypoints += f.left_keypoints;
     stereo_matches += f.stereo_matches;
+    below_min_disparity += f.below_min_disparity;
     observations += f.observations.size();
     for (bool is_new : f.is_new) ++(is_new ? created : associated);
     times.detect += f.times.detect;
@@ -58,6 +61,9 @@ void print_front_end(const FrontEndTotals& t, const vision::SequenceClock& clock
   std::printf("front-end over %zu frames: %.0f left keypoints, %.0f stereo matches, %.1f observations per frame "
               "(%.1f associated, %.1f proposed as new)",
               t.frames, t.left_keypoints / n, t.stereo_matches / n, t.observations / n, t.associated / n, t.created / n);
+  if (t.min_disparity > 0)
+    std::printf("; %zu stereo matches in all dropped below the disparity floor (%.2f px, %g standard deviations)",
+                t.below_min_disparity, t.min_disparity, settings.min_disparity_sigmas);
   if (truth)
     std::printf("; association precision %.4f (%zu of %zu right against the rendering)", truth->precision(),
                 truth->right(), truth->associated());
@@ -136,8 +142,10 @@ void draw_pipeline_picture(const std::filesystem::path& file, const PictureFrame
   if (!cv::imwrite(file.string(), canvas)) throw invalid_input_error(file.string() + ": cannot be written");
 }
 
-vision::StereoTrackerOptions tracker_options(const RunnerConfig& c) {
+/// The tracker's settings from [globe]; the disparity floor in standard deviations of the sensor's pixel noise.
+vision::StereoTrackerOptions tracker_options(const RunnerConfig& c, const PointInCamera3D& sensor) {
   vision::StereoTrackerOptions o;
+  o.front_end.min_disparity = vision::significant_disparity(sensor.noise.pixel_sigma, c.globe.min_disparity_sigmas);
   o.pool = c.globe.pool;
   o.association.max_observations = static_cast<std::size_t>(c.globe.features_per_frame);
   o.front_end.detector.octave_layers = c.globe.octave_layers;
@@ -162,11 +170,11 @@ auto with_tracker(const RunnerConfig& c, const EulerCamera12D& motion, const Poi
     seif.max_active = active.front();
     if (relocalizing) seif.sparsification = SeifSparsification::relocalization;
     vision::StereoTracker<SeifSlam<EulerCamera12D, PointInCamera3D>> tracker(
-        {motion, sensor, prior, seif}, sensor, rig, width, height, tracker_options(c));
+        {motion, sensor, prior, seif}, sensor, rig, width, height, tracker_options(c, sensor));
     return run(tracker, std::string(seif.sparsification == SeifSparsification::relocalization ? "ESEIF" : "SEIF"));
   }
   vision::StereoTracker<EkfSlam<EulerCamera12D, PointInCamera3D>> tracker({motion, sensor, prior, c.ekf}, sensor,
-                                                                           rig, width, height, tracker_options(c));
+                                                                           rig, width, height, tracker_options(c, sensor));
   return run(tracker, std::string("EKF"));
 }
 
@@ -223,6 +231,7 @@ std::vector<TableRow> run_globe_stereo(const CliOptions& cli, const std::string&
                       [&](auto& tracker, const std::string& tracker_name) {
     eval::GlobeAssociationTruth truth(o);
     FrontEndTotals totals;
+    totals.min_disparity = tracker.front_end().options().min_disparity;
     sim::GlobeCameraDataset stereo = points;
     std::vector<Observations> frames;
     std::vector<std::vector<bool>> is_new;
@@ -287,6 +296,7 @@ std::vector<TableRow> run_stereo_directory(const CliOptions& cli, const std::str
     std::printf("\n== stereo:%s: %zu rectified pairs, %dx%d, f = %.1f px, baseline %.3f m, dt %.4f s; %s tracking\n",
                 dir.c_str(), sequence.size(), c.width, c.height, c.K(0, 0), c.baseline, c.dt, tracker_name.c_str());
     FrontEndTotals totals;
+    totals.min_disparity = tracker.front_end().options().min_disparity;
     std::vector<Observations> frames;
     std::vector<std::vector<bool>> is_new;
     std::vector<io::TumPose> trajectory;

@@ -7,9 +7,11 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <future>
 #include <numeric>
 #include <opencv2/core.hpp>
+#include <string>
 #include <vector>
 
 #include "sextant/vision/features.hpp"
@@ -30,6 +32,11 @@ struct FrontEndOptions {
   bool parallel_detection = true;  ///< detect_both: left and right on two threads
   StereoCorrespondence correspondence = StereoCorrespondence::detect_both;
   RowSearchOptions row_search{};   ///< row_search's settings
+  /// px: a match of smaller disparity is dropped before triangulation (significant_disparity gives
+  /// the bound for a number of standard deviations). 0 keeps every match: a wrong match at a pixel of
+  /// disparity on the rendered globe becomes a landmark 170 m deep that the sparse filters' mean
+  /// recovery cannot hold (docs/results/real_time.md, "A disparity floor").
+  double min_disparity = 0.0;
 };
 
 /// One stereo match as a measurement.
@@ -48,13 +55,18 @@ struct StereoFrame {
   std::vector<StereoFeature> features;  ///< strongest left response first
   cv::Mat descriptors;                  ///< row i: the left descriptor of features[i]
   std::size_t left_keypoints = 0, right_keypoints = 0;
+  std::size_t below_min_disparity = 0;  ///< matches dropped by FrontEndOptions::min_disparity
   FrontEndTimes times;
 };
 
 class StereoFrontEnd {
  public:
   StereoFrontEnd(StereoRig rig, FrontEndOptions options = {})
-      : rig_(rig), options_(options), left_(make_detector(options.detector)), right_(make_detector(options.detector)) {}
+      : rig_(rig), options_(options), left_(make_detector(options.detector)), right_(make_detector(options.detector)) {
+    if (!(options.min_disparity >= 0.0) || !std::isfinite(options.min_disparity))
+      throw invalid_input_error("stereo front-end: min_disparity " + std::to_string(options.min_disparity) +
+                                " px must be finite and >= 0");
+  }
 
   const StereoRig& rig() const { return rig_; }
   const FrontEndOptions& options() const { return options_; }
@@ -111,7 +123,9 @@ class StereoFrontEnd {
     });
   }
 
-  void triangulate_matches(const std::vector<StereoMatch>& matches, const Features& left, StereoFrame& out) const {
+  void triangulate_matches(std::vector<StereoMatch>& matches, const Features& left, StereoFrame& out) const {
+    const auto too_small = [&](const StereoMatch& m) { return m.disparity() < options_.min_disparity; };
+    out.below_min_disparity = static_cast<std::size_t>(std::erase_if(matches, too_small));
     out.features.reserve(matches.size());
     out.descriptors.create(static_cast<int>(matches.size()), left.descriptors.cols, left.descriptors.type());
     for (std::size_t i = 0; i < matches.size(); ++i) {

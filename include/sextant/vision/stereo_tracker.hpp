@@ -51,6 +51,7 @@ struct TrackedFrame {
   std::vector<StereoFeature> observed;                     ///< the feature behind each observation
   std::vector<bool> is_new;                                ///< per observation: it proposed a new landmark
   std::size_t left_keypoints = 0, right_keypoints = 0, stereo_matches = 0, predicted = 0, gated_unmatched = 0;
+  std::size_t below_min_disparity = 0;  ///< stereo matches the front-end dropped (FrontEndOptions::min_disparity)
   UpdateResult update;
   TrackerTimes times;
 };
@@ -96,6 +97,7 @@ class StereoTracker {
     out.left_keypoints = frame.left_keypoints;
     out.right_keypoints = frame.right_keypoints;
     out.stereo_matches = frame.features.size();
+    out.below_min_disparity = frame.below_min_disparity;
     auto start = Clock::now();
     backend_.predict(control, dt);
     out.times.backend = seconds_since(start);

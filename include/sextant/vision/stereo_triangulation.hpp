@@ -4,6 +4,7 @@
 /// pixel's ray; its covariance propagated from the pixel noise (StereoPointNoise).
 
 #include <Eigen/Core>
+#include <cmath>
 #include <string>
 
 #include "sextant/core/error.hpp"
@@ -18,6 +19,12 @@ struct StereoRig {
   double cx = 320.0, cy = 240.0;  ///< px
   double baseline = 0.1;          ///< m
 };
+
+/// The smallest disparity that `sigmas` of its standard deviations (sqrt(2) pixel_sigma: u_left and
+/// u_right each noisy) set apart from zero, the disparity of a point at infinity. Below it the depth
+/// z = f b / d is mostly noise: its first-order standard deviation sqrt(2) sigma z / d exceeds
+/// z / sigmas, and a Gaussian in xyz puts more than the normal tail beyond `sigmas` behind the camera.
+inline double significant_disparity(double pixel_sigma, double sigmas) { return sigmas * std::sqrt(2.0) * pixel_sigma; }
 
 /// The match's point in the left camera frame (x right, y down, z forward). Throws
 /// invalid_input_error for a disparity <= 0 (no finite depth).
