@@ -90,6 +90,13 @@ TEST(Metrics, TimeAveragedAneesIntervalCoversAConsistentEstimatorWithCorrelatedS
   // Treating the 2000 correlated steps as independent gives an interval far too narrow.
   EXPECT_LT(covered_by_independent_steps_interval, 0.7 * kTrials);
   EXPECT_THROW(time_averaged_anees_interval(2, std::vector<double>{2.0}), invalid_input_error);
+  // Two runs far apart: t(1 dof) s / sqrt(2) = 12.7 x 7.0 / 1.41 = 62.9, so dof - 62.9 < 0; the
+  // interval starts at 0 and keeps its upper end.
+  const std::vector<double> scattered{0.1, 10.0};
+  const double half_width = 12.706204736174698 * std::sqrt(0.5 * 9.9 * 9.9) / std::sqrt(2.0);
+  const auto wide = time_averaged_anees_interval(2, scattered);
+  EXPECT_EQ(wide.lower, 0.0);
+  EXPECT_NEAR(wide.upper, 2.0 + half_width, 1e-9);
 }
 
 }  // namespace

@@ -84,7 +84,8 @@ inline Interval anees_interval(int dof, int runs, double confidence = 0.95) {
 /// are independent but the steps of one run are not (the error at step k carries into k + 1), so
 /// no chi-square with N K dof applies. Each run's time average a_i = (1/K) sum_k NEES_ik has mean
 /// dof; the a_i are i.i.d., so their mean lies in dof +- t_{N-1} s / sqrt(N) (s: sample standard
-/// deviation of the a_i; Student's t at the given confidence). Needs N >= 2.
+/// deviation of the a_i; Student's t at the given confidence), its lower end at least 0: a NEES
+/// is never negative, where runs that scatter widely would put dof - t s / sqrt(N). Needs N >= 2.
 inline Interval time_averaged_anees_interval(int dof, std::span<const double> per_run_averages,
                                              double confidence = 0.95) {
   const std::size_t n = per_run_averages.size();
@@ -95,7 +96,7 @@ inline Interval time_averaged_anees_interval(int dof, std::span<const double> pe
   const double s = std::sqrt(sum_sq / static_cast<double>(n - 1));
   const double t = boost::math::quantile(boost::math::students_t(static_cast<double>(n - 1)), 0.5 * (1.0 + confidence));
   const double half_width = t * s / std::sqrt(static_cast<double>(n));
-  return {dof - half_width, dof + half_width};
+  return {std::max(0.0, dof - half_width), dof + half_width};
 }
 
 /// Per-step ANEES: element-wise mean over runs of per-step NEES series of equal length.
