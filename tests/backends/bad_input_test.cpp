@@ -137,6 +137,34 @@ TYPED_TEST(BadInput, LandmarkRepeatedWithinOneUpdate) {
   this->expect_error_and_no_change([&] { this->backend_.update(repeated_new); }, "twice");
 }
 
+TYPED_TEST(BadInput, NoiseScaleThatIsNotPositiveAndFinite) {
+  for (double scale : {0.0, -1.0, kNaN, kInf}) {
+    const std::vector<Obs> known{{this->known(0), {1.0, 1.0}}, {this->known(1), {2.0, 1.0}, scale}};
+    this->expect_error_and_no_change([&] { this->backend_.update(known); }, "noise_scale");
+    const std::vector<Obs> fresh{{this->known(0), {1.0, 1.0}}, {777, {2.0, 1.0}, scale}};
+    this->expect_error_and_no_change([&] { this->backend_.update(fresh); }, "measurement of landmark 777: noise_scale");
+  }
+}
+
+/// Observation::noise_scale s weighs a measurement as the sensor with noise s^2 Q would: every path
+/// that uses Q (a new landmark's covariance, the update, FastSLAM's proposal and weights, the
+/// graph's factors) gives the same estimate to the bit with sigma 2 and s = 1.5 as with sigma 3.
+TYPED_TEST(BadInput, AnObservationsNoiseScaleWeighsItAsTheSensorWithThatMuchNoise) {
+  auto steps = test::random_linear_steps(12, 5, 3);
+  auto scaled = TypeParam::make(BeaconShip2D{}, BeaconOffset2D{.sigma = 2.0}, kPrior);
+  auto noisier = TypeParam::make(BeaconShip2D{}, BeaconOffset2D{.sigma = 3.0}, kPrior);
+  eval::run(noisier, steps);
+  for (auto& step : steps)
+    for (auto& observation : step.observations) observation.noise_scale = 1.5;
+  eval::run(scaled, steps);
+  Snapshot<typename TestFixture::Backend>(noisier).expect_same_as(scaled);
+  auto unscaled = TypeParam::make(BeaconShip2D{}, BeaconOffset2D{.sigma = 2.0}, kPrior);
+  for (auto& step : steps)
+    for (auto& observation : step.observations) observation.noise_scale = 1.0;
+  eval::run(unscaled, steps);
+  EXPECT_NE(unscaled.map().front().cov, scaled.map().front().cov);  // the scale is not ignored
+}
+
 TYPED_TEST(BadInput, RemoveUnknownLandmark) {
   this->expect_error_and_no_change([&] { this->backend_.remove_landmark(12345); }, "unknown landmark id 12345");
   EXPECT_THROW(this->backend_.remove_landmark(12345), unknown_landmark_error);

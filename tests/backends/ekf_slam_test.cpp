@@ -65,9 +65,10 @@ TEST(EkfSlam, BlockSparseUpdateEqualsTextbookDenseUpdate) {
   const auto steps = test::random_linear_steps(10, 6, 10);
   Ekf ekf{kMotion, kSensor, kPrior};
   eval::run(ekf, steps);
-  // One more correction of four known landmarks, both ways.
+  // One more correction of four known landmarks, both ways, each with its own noise scale.
   std::vector<Observation<Eigen::Vector2d>> observations;
-  for (std::size_t i = 0; i < 4; ++i) observations.push_back({ekf.landmark_ids()[i], Eigen::Vector2d(i, 1.0)});
+  const double scales[] = {1.0, 0.5, 2.0, 3.0};
+  for (std::size_t i = 0; i < 4; ++i) observations.push_back({ekf.landmark_ids()[i], Eigen::Vector2d(i, 1.0), scales[i]});
   Eigen::MatrixXd P = ekf.covariance();
   Eigen::VectorXd mean(P.rows());
   mean.head<2>() = ekf.pose().mean;

@@ -91,7 +91,7 @@ struct CircleRun {
       for (const auto& observation : observations[k])
         if (!first.contains(observation.landmark_id))
           first.emplace(observation.landmark_id,
-                        initialize_landmark(seif_sensor, predicted, observation.z, observation.landmark_id).m);
+                        initialize_landmark(seif_sensor, predicted, observation.z, observation.landmark_id, 1.0).m);
     }
     return first;
   }

@@ -386,6 +386,25 @@ StereoFrame hand_made_frame(const std::vector<std::pair<Eigen::Vector3d, int>>& 
 
 cv::Mat descriptor_of(int fill) { return cv::Mat(1, 8, CV_8U, cv::Scalar(fill)); }
 
+/// A feature whose noise is s times the model's is gated with H P H^T + s^2 Q: 6 cm from a landmark
+/// predicted with H P H^T = Q = 1e-4 I it is outside the 99.9% gate (NIS 18 > 16.27) and becomes a
+/// new landmark; with noise scale 2 (S = 5e-4 I, NIS 7.2) it is associated.
+TEST(MapAssociation, AFeaturesNoiseScaleWidensItsGate) {
+  const Eigen::Matrix3d part = 1e-4 * Eigen::Matrix3d::Identity();
+  const std::vector<PredictedLandmark> predicted = {{7, {0, 0, 1}, (part + part).inverse(), part, part}};
+  LandmarkAppearance appearance;
+  appearance.set(7, descriptor_of(0x00));
+  for (const double scale : {1.0, 2.0}) {
+    StereoFrame frame = hand_made_frame({{{0.06, 0, 1}, 0x00}});
+    frame.features[0].noise_scale = scale;
+    LandmarkId next = 100;
+    const auto a = associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance, next, {});
+    ASSERT_EQ(a.observations.size(), 1u);
+    EXPECT_EQ(a.observations[0].landmark_id, scale == 1.0 ? 100u : 7u) << scale;
+    EXPECT_EQ(a.observations[0].noise_scale, scale);  // handed on to the back-end
+  }
+}
+
 TEST(MapAssociation, GateThenDescriptorOneFeaturePerLandmark) {
   // Landmarks 7 and 8 predicted 1 mm apart, 1 cm standard deviation per axis: both gates hold
   // features 0, 1 and 3; feature 2 is in neither.

@@ -216,10 +216,11 @@ class FastSlam {
     Eigen::Matrix<double, Z, 1> nu;
     Eigen::LLT<Eigen::Matrix<double, Z, Z>> llt;  ///< of S = H_x Sigma H_x^T + H_m Sigma_m H_m^T + Q
   };
-  auto predict_if_observable(const State& x, const Landmark& m) const -> std::optional<Prediction>;
+  auto predict_if_observable(const State& x, const Landmark& m, double noise_scale) const -> std::optional<Prediction>;
   std::vector<ObservationType> add_new_landmarks(std::vector<Particle>& particles, std::span<const ObservationType> fresh,
                                                  std::vector<LandmarkId>& unusable) const;
-  LandmarkUpdate update_landmark(Particle& particle, std::size_t index, const Measurement& z, bool unassociated) const;
+  LandmarkUpdate update_landmark(Particle& particle, std::size_t index, const Measurement& z, double noise_scale,
+                                 bool unassociated) const;
   template <class Llt>
   double log_likelihood_at_gate_edge(const Llt& llt) const;
   ProposalInnovation proposal_innovation(Prediction prediction, const PoseMatrix& cov, const LandmarkGaussian<M>& landmark,

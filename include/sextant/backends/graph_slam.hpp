@@ -165,6 +165,7 @@ class GraphSlam {
   struct MeasurementRecord {
     std::size_t pose;
     Measurement z;
+    double noise_scale;  ///< Observation::noise_scale
   };
   /// A marginalized landmark: 1/2 d^T Lambda d - eta^T d over the stacked d = minus(x_p, linearization_p).
   struct LinearFactor {
@@ -188,7 +189,7 @@ class GraphSlam {
   PriorInformation prior_information_at(const State& x0) const;
   template <class PoseAt>
   typename Online::PoseFactor marginal_information(const LinearFactor& factor, PoseAt&& pose_at) const;
-  std::optional<FactorInformation<X, M>> measurement_information(std::size_t slot, const Measurement& z, const State& x,
+  std::optional<FactorInformation<X, M>> measurement_information(std::size_t slot, const MeasurementRecord& record, const State& x,
                                                                  const Landmark& m) const;
   template <int D>
   static void require_factorizable_extension(const Eigen::Matrix<double, X, X>& P, const Eigen::Matrix<double, D, X>& J,

@@ -153,7 +153,7 @@ class DataAssociation {
   std::optional<Pair> pairing(const JointMarginal<State, M>& joint, std::size_t i, const Measurement& z,
                               std::size_t j) const {
     try {
-      const auto lin = linearize_observation(sensor_, joint.robot, joint.landmarks[j], z, joint.ids[j], 0);
+      const auto lin = linearize_observation(sensor_, joint.robot, joint.landmarks[j], z, joint.ids[j], 0, 1.0);
       Pair pair{i, j, lin.J_z_x, lin.J_z_m, lin.Q, lin.residual};
       const auto llt = cholesky_or_throw(innovation_block(joint, pair, pair), "innovation covariance");
       pair.nis = mahalanobis_squared(llt, pair.residual);

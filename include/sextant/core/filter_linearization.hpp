@@ -27,7 +27,8 @@ auto linearize_for_filter(const Sensor& sensor, const typename Space::Point& x, 
                           const Landmark& first, const Observation& observation, Eigen::Index offset,
                           const typename Space::Point& propagated, JacobianChoice choice,
                           std::vector<LandmarkId>& unusable) {
-  auto lin = linearize_if_observable(sensor, x, m, observation.z, observation.landmark_id, offset, unusable);
+  auto lin = linearize_if_observable(sensor, x, m, observation.z, observation.landmark_id, offset,
+                                     observation.noise_scale, unusable);
   if (!lin) return lin;
   if (choice.first_estimate_jacobians) use_first_estimate_jacobians(sensor, x, first, observation.z, *lin);
   constrain_observation_if<Space>(choice.observability_constraints, *lin, propagated, first);

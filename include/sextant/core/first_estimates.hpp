@@ -13,12 +13,12 @@ namespace sextant {
 
 /// Replaces lin's H with the one at the landmark's first estimate `first`; the residual stays the
 /// one at the current estimate. Where the model cannot predict from the first estimate (e.g.
-/// behind the camera from here), H stays current.
+/// behind the camera from here), H stays current. Only H is taken from there: the noise stays lin's.
 template <class Sensor, class State, class Landmark, class Measurement, int Z, int X, int M>
 void use_first_estimate_jacobians(const Sensor& sensor, const State& x, const Landmark& first, const Measurement& z,
                                   LinearizedObservation<Z, X, M>& lin) {
   std::vector<LandmarkId> unusable_from_first;
-  const auto at_first = linearize_if_observable(sensor, x, first, z, lin.id, lin.offset, unusable_from_first);
+  const auto at_first = linearize_if_observable(sensor, x, first, z, lin.id, lin.offset, 1.0, unusable_from_first);
   if (!at_first) return;
   lin.J_z_x = at_first->J_z_x;
   lin.J_z_m = at_first->J_z_m;

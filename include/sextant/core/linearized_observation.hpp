@@ -24,7 +24,8 @@ struct LinearizedObservation {
   Eigen::Matrix<double, Z, 1> residual; ///< z - h(x, m), wrapped by the model
 };
 
-/// Linearizes `sensor` at robot state x and landmark mean m for measurement z. Throws
+/// Linearizes `sensor` at robot state x and landmark mean m for measurement z, whose noise is
+/// `noise_scale` times the model's (Observation::noise_scale). Throws
 /// numerical_error when the model returns NaN or Inf, when Q is not positive definite, or when the
 /// squared residual weighted by Q^-1 overflows: a measurement that implausible (e.g. 1e300 m from
 /// its prediction, or a residual of 1 with sigma 1e-160) is rejected by every back-end, since
@@ -32,8 +33,8 @@ struct LinearizedObservation {
 /// unless the back-end's gate is on.
 template <class Sensor, class State, class Landmark, class Measurement>
 auto linearize_observation(const Sensor& sensor, const State& x, const Landmark& m, const Measurement& z,
-                           LandmarkId id, Eigen::Index offset) {
-  const auto prediction = sensor.predict(x, m);
+                           LandmarkId id, Eigen::Index offset, double noise_scale) {
+  const auto prediction = with_noise_scale(sensor.predict(x, m), noise_scale);
   using Prediction = decltype(prediction);
   constexpr int Z = decltype(Prediction::z)::RowsAtCompileTime;
   constexpr int X = decltype(Prediction::J_z_x)::ColsAtCompileTime;
@@ -54,10 +55,10 @@ auto linearize_observation(const Sensor& sensor, const State& x, const Landmark&
 /// (unobservable_error, e.g. the landmark behind the camera): its id then goes to `unusable`.
 template <class Sensor, class State, class Landmark, class Measurement>
 auto linearize_if_observable(const Sensor& sensor, const State& x, const Landmark& m, const Measurement& z,
-                             LandmarkId id, Eigen::Index offset, std::vector<LandmarkId>& unusable)
-    -> std::optional<decltype(linearize_observation(sensor, x, m, z, id, offset))> {
+                             LandmarkId id, Eigen::Index offset, double noise_scale, std::vector<LandmarkId>& unusable)
+    -> std::optional<decltype(linearize_observation(sensor, x, m, z, id, offset, noise_scale))> {
   try {
-    return linearize_observation(sensor, x, m, z, id, offset);
+    return linearize_observation(sensor, x, m, z, id, offset, noise_scale);
   } catch (const unobservable_error&) {
     unusable.push_back(id);
     return std::nullopt;

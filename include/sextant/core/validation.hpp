@@ -80,6 +80,9 @@ void require_valid_observations(std::span<const Observation<Measurement>> observ
   seen.reserve(observations.size());
   for (const auto& observation : observations) {
     require_finite(observation.z, "measurement of landmark " + std::to_string(observation.landmark_id));
+    if (!(observation.noise_scale > 0.0) || !std::isfinite(observation.noise_scale))
+      throw invalid_input_error("measurement of landmark " + std::to_string(observation.landmark_id) + ": noise_scale " +
+                                std::to_string(observation.noise_scale) + " is not a positive finite number");
     if (!seen.insert(observation.landmark_id).second)
       throw duplicate_landmark_error("landmark id " + std::to_string(observation.landmark_id) +
                                      " is observed twice in one update");

@@ -29,7 +29,8 @@ DenseLinearization linearize_dense(const Backend& backend, const Sensor& sensor,
   for (Eigen::Index i = 0; i < k; ++i) {
     const auto& obs = observations[i];
     const Eigen::Index slot = std::find(ids.begin(), ids.end(), obs.landmark_id) - ids.begin();
-    const auto prediction = sensor.predict(backend.pose().mean, backend.landmark(obs.landmark_id).mean);
+    const auto prediction =
+        with_noise_scale(sensor.predict(backend.pose().mean, backend.landmark(obs.landmark_id).mean), obs.noise_scale);
     out.H.block(Z * i, 0, Z, X) = prediction.J_z_x;
     out.H.block(Z * i, X + M * slot, Z, M) = prediction.J_z_m;
     out.Q.block(Z * i, Z * i, Z, Z) = prediction.Q;

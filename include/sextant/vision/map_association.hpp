@@ -9,6 +9,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -51,11 +52,21 @@ enum class GateCovariance {
   conditional,
 };
 
-/// A map landmark's predicted measurement with the inverse of its innovation covariance.
+/// A map landmark's predicted measurement with the inverse of its innovation covariance S = H P H^T
+/// + Q, and S's two parts: a feature whose noise is s times the model's (StereoFeature::noise_scale)
+/// is gated with H P H^T + s^2 Q. With the parts left zero, S_inverse serves every feature.
 struct PredictedLandmark {
   LandmarkId id;
   Eigen::Vector3d z;
   Eigen::Matrix3d S_inverse;
+  Eigen::Matrix3d state_part = Eigen::Matrix3d::Zero();  ///< H P H^T
+  Eigen::Matrix3d Q = Eigen::Matrix3d::Zero();           ///< the model's measurement noise there
+
+  /// S^-1 for a feature of noise scale s.
+  Eigen::Matrix3d S_inverse_for(double s) const {
+    if (s == 1.0 || Q.isZero(0.0)) return S_inverse;
+    return (state_part + s * s * Q).inverse();
+  }
 };
 
 /// The descriptor that stands for each landmark in the back-end (vision/stereo_tracker.hpp picks which).
@@ -125,9 +136,10 @@ std::vector<PredictedLandmark> predict_landmarks_in_view(const Backend& backend,
   std::vector<PredictedLandmark> out;
   auto add = [&](std::size_t i, const auto& cov, Eigen::Index a) {
     const auto& p = predictions[i];
-    const Eigen::Matrix3d S = innovation_cross_block(cov, p.J_z_x, p.J_z_m, a, p.J_z_x, p.J_z_m, a) + p.Q;
-    const Eigen::LLT<Eigen::Matrix3d> llt(S);
-    if (llt.info() == Eigen::Success) out.push_back({in_view[i], p.z, llt.solve(Eigen::Matrix3d::Identity())});
+    const Eigen::Matrix3d state_part = innovation_cross_block(cov, p.J_z_x, p.J_z_m, a, p.J_z_x, p.J_z_m, a);
+    const Eigen::LLT<Eigen::Matrix3d> llt(state_part + p.Q);
+    if (llt.info() == Eigen::Success)
+      out.push_back({in_view[i], p.z, llt.solve(Eigen::Matrix3d::Identity()), state_part, p.Q});
   };
   if (in_view.empty()) return out;
   const std::span<const LandmarkId> ids(in_view);
@@ -168,6 +180,20 @@ inline double gate_reach(const Eigen::Matrix3d& S_inverse, double gate) {
   return smallest > 0.0 ? 1.000001 * std::sqrt(gate / smallest) : std::numeric_limits<double>::infinity();
 }
 
+/// The gate's reach for each noise scale s: |r|^2 <= gate lambda_max(S_s) with lambda_max(S_s) <=
+/// lambda_max(H P H^T) + s^2 lambda_max(Q), a bound that costs nothing per feature.
+struct ScaledReach {
+  double state = 0.0, noise = 0.0;  ///< gate times the two largest eigenvalues
+  ScaledReach(const PredictedLandmark& p, double gate) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+    eigen.computeDirect(p.state_part, Eigen::EigenvaluesOnly);
+    state = gate * eigen.eigenvalues()(2);
+    eigen.computeDirect(p.Q, Eigen::EigenvaluesOnly);
+    noise = gate * eigen.eigenvalues()(2);
+  }
+  bool may_hold(const Eigen::Vector3d& r, double s) const { return r.squaredNorm() <= 1.000001 * (state + s * s * noise); }
+};
+
 /// Per feature, its nearest landmark descriptor among the landmarks whose gate it is inside, kept
 /// when within max_descriptor_distance and the ratio test against the second nearest; `gated[i]`:
 /// feature i is inside some gate. Each landmark tests only the features within its gate's reach
@@ -184,13 +210,22 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
   xs.reserve(frame.features.size());
   for (const StereoFeature& f : frame.features) xs.push_back(f.point.x());
   const SortedIndex by_x(xs);
+  double widest = 1.0;  // the largest noise scale among the features: the reach must hold its gate
+  bool scaled_features = false;
+  for (const StereoFeature& f : frame.features) {
+    widest = std::max(widest, f.noise_scale);
+    scaled_features |= f.noise_scale != 1.0;
+  }
   for (std::size_t j = 0; j < predicted.size(); ++j) {
     const cv::Mat* descriptor = appearance.find(predicted[j].id);
-    const double reach = gate_reach(predicted[j].S_inverse, gate), x = predicted[j].z.x();
+    const double reach = gate_reach(predicted[j].S_inverse_for(widest), gate), x = predicted[j].z.x();
+    const auto scaled = scaled_features ? std::optional<ScaledReach>(std::in_place, predicted[j], gate) : std::nullopt;
     for (const int feature : by_x.band(x, reach)) {
       const auto i = static_cast<std::size_t>(feature);
       const Eigen::Vector3d r = frame.features[i].point - predicted[j].z;
-      const double nis = r.dot(predicted[j].S_inverse * r);
+      const double s = frame.features[i].noise_scale;
+      if (s != 1.0 && !scaled->may_hold(r, s)) continue;
+      const double nis = s == 1.0 ? r.dot(predicted[j].S_inverse * r) : r.dot(predicted[j].S_inverse_for(s) * r);
       if (!(nis <= gate)) continue;
       gated[i] = true;
       if (!descriptor) continue;
@@ -239,7 +274,8 @@ inline FrameAssociation associate_to_map(const StereoFrame& frame, std::span<con
   FrameAssociation out;
   for (std::size_t i = 0; i < frame.features.size() && out.observations.size() < o.max_observations; ++i) {
     if (landmark_of[i] < 0) continue;
-    out.observations.push_back({predicted[static_cast<std::size_t>(landmark_of[i])].id, frame.features[i].point});
+    out.observations.push_back(
+        {predicted[static_cast<std::size_t>(landmark_of[i])].id, frame.features[i].point, frame.features[i].noise_scale});
     out.feature.push_back(i);
     ++out.associated;
   }
@@ -250,7 +286,7 @@ inline FrameAssociation associate_to_map(const StereoFrame& frame, std::span<con
       continue;
     }
     if (out.observations.size() >= o.max_observations) continue;
-    out.observations.push_back({next_id++, frame.features[i].point});
+    out.observations.push_back({next_id++, frame.features[i].point, frame.features[i].noise_scale});
     out.feature.push_back(i);
     ++out.created;
   }

@@ -16,6 +16,7 @@
 
 #include "sextant/vision/features.hpp"
 #include "sextant/vision/row_search_matching.hpp"
+#include "sextant/vision/slant_noise.hpp"
 #include "sextant/vision/stereo_matching.hpp"
 #include "sextant/vision/stereo_triangulation.hpp"
 
@@ -37,6 +38,10 @@ struct FrontEndOptions {
   /// disparity on the rendered globe becomes a landmark 170 m deep that the sparse filters' mean
   /// recovery cannot hold (docs/results/real_time.md, "A disparity floor").
   double min_disparity = 0.0;
+  /// Each point's noise scaled by 1 / cos of the slant of the surface around it (vision/slant_noise.hpp):
+  /// features seen obliquely weigh less instead of being dropped or trusted as frontal ones.
+  bool slant_noise = false;
+  SlantNoiseOptions slant{};
 };
 
 /// One stereo match as a measurement.
@@ -44,6 +49,7 @@ struct StereoFeature {
   Eigen::Vector2d left_px = Eigen::Vector2d::Zero(), right_px = Eigen::Vector2d::Zero();
   float size = 0.0f, response = 0.0f;  ///< of the left keypoint
   Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< in the left camera frame (x right, y down, z forward)
+  double noise_scale = 1.0;  ///< its noise against the stereo model's (FrontEndOptions::slant_noise; 1 without)
 };
 
 /// Seconds per stage of one frame.
@@ -66,6 +72,7 @@ class StereoFrontEnd {
     if (!(options.min_disparity >= 0.0) || !std::isfinite(options.min_disparity))
       throw invalid_input_error("stereo front-end: min_disparity " + std::to_string(options.min_disparity) +
                                 " px must be finite and >= 0");
+    if (options.slant_noise) require_valid(options.slant);
   }
 
   const StereoRig& rig() const { return rig_; }
@@ -134,6 +141,15 @@ class StereoFrontEnd {
       out.features.push_back({m.left_px, m.right_px, k.size, k.response, triangulate(rig_, m)});
       left.descriptors.row(m.left).copyTo(out.descriptors.row(static_cast<int>(i)));
     }
+    if (options_.slant_noise) scale_noise_by_slant(out.features);
+  }
+
+  void scale_noise_by_slant(std::vector<StereoFeature>& features) const {
+    std::vector<Eigen::Vector2d> pixels;
+    std::vector<Eigen::Vector3d> points;
+    for (const auto& f : features) pixels.push_back(f.left_px), points.push_back(f.point);
+    const auto scales = slant_noise_scales(pixels, points, options_.slant);
+    for (std::size_t i = 0; i < features.size(); ++i) features[i].noise_scale = scales[i];
   }
 
   StereoRig rig_;

@@ -89,7 +89,7 @@ auto EkfSlam<Motion, Sensor>::rejected_sightings(std::span<const ObservationType
     const std::size_t slot = landmarks_.slot(observation.landmark_id);
     const Landmark m = landmark_mean(slot);
     try {
-      const auto p = sensor_.predict(x_, m);
+      const auto p = with_noise_scale(sensor_.predict(x_, m), observation.noise_scale);
       const Eigen::Matrix<double, M, M> P_mm = symmetric_diagonal_block<M>(cov_.view(), offset_of(slot));
       out.push_back({observation.landmark_id, x_, m, observation.z,
                      symmetrized(p.J_z_m * P_mm * p.J_z_m.transpose() + p.Q)});

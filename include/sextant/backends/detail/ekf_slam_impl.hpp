@@ -299,7 +299,8 @@ auto EkfSlam<Motion, Sensor>::plan(std::span<const ObservationType> known, std::
   // (|P_m,j| <= sqrt(P_mm P_jj)): augment() in commit() cannot overflow.
   const Eigen::Matrix<double, X, X> P_xx = symmetric_diagonal_block<X>(cov_.view(), 0);
   for (const auto& observation : fresh) {
-    auto initialized = initialize_if_observable(sensor_, x_after, observation.z, observation.landmark_id, result.unusable);
+    auto initialized = initialize_if_observable(sensor_, x_after, observation.z, observation.landmark_id,
+                                                observation.noise_scale, result.unusable);
     if (!initialized) continue;
     auto& init = *initialized;
     if (!(init.J_m_x * P_xx * init.J_m_x.transpose()).allFinite())

@@ -155,10 +155,10 @@ double FastSlam<Motion, Sensor, Map>::log_likelihood_at_gate_edge(const Llt& llt
 /// likelihood log N(nu; 0, S), S = H_m Sigma_m H_m^T + Q (eqs. 79-81).
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::size_t index, const Measurement& z,
-                                                    bool unassociated) const -> LandmarkUpdate {
+                                                    double noise_scale, bool unassociated) const -> LandmarkUpdate {
   auto& map = unassociated ? particle.unassociated : particle.landmarks;
   const LandmarkGaussian<M>& L = map[index];
-  const auto prediction = predict_if_observable(particle.x, L.mean);
+  const auto prediction = predict_if_observable(particle.x, L.mean, noise_scale);
   if (!prediction) return {0.0, Outcome::unusable};
   const auto& pred = *prediction;
   const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(z, pred.z);
@@ -179,10 +179,10 @@ auto FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::siz
 /// particle the landmark is behind the camera). Such an observation neither shapes the particle
 /// nor weighs on it: a Gaussian likelihood is not defined there.
 template <class Motion, class Sensor, template <class> class Map>
-auto FastSlam<Motion, Sensor, Map>::predict_if_observable(const State& x, const Landmark& m) const
+auto FastSlam<Motion, Sensor, Map>::predict_if_observable(const State& x, const Landmark& m, double noise_scale) const
     -> std::optional<Prediction> {
   try {
-    return sensor_.predict(x, m);
+    return with_noise_scale(sensor_.predict(x, m), noise_scale);
   } catch (const unobservable_error&) {
     return std::nullopt;
   }
@@ -231,7 +231,7 @@ auto FastSlam<Motion, Sensor, Map>::propose_v2(Particle& particle, const PoseEst
       continue;
     }
     const LandmarkGaussian<M>& L = particle.landmarks[index_.at(known[i].landmark_id)];
-    auto prediction = predict_if_observable(mean, L.mean);
+    auto prediction = predict_if_observable(mean, L.mean, known[i].noise_scale);
     if (!prediction) {
       outcomes[i] = Outcome::unusable;
       continue;
@@ -252,7 +252,7 @@ void FastSlam<Motion, Sensor, Map>::draw_from_proposal(Particle& particle, std::
   draw_into(particle, {particle.drawn_from, particle.drawn_cov}, rng);
   for (std::size_t i = 0; i < known.size(); ++i)
     if (outcomes[i] == Outcome::used &&
-        update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false).outcome == Outcome::unusable)
+        update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, known[i].noise_scale, false).outcome == Outcome::unusable)
       outcomes[i] = Outcome::unusable;
 }
 
@@ -292,7 +292,7 @@ std::vector<bool> FastSlam<Motion, Sensor, Map>::accepted_by_cloud(const std::ve
     double total = 0.0;
     for (std::size_t n = 0; n < particles.size(); ++n) {
       const LandmarkGaussian<M>& L = particles[n].landmarks[index];
-      const auto p = predict_if_observable(poses[n].mean, L.mean);
+      const auto p = predict_if_observable(poses[n].mean, L.mean, known[i].noise_scale);
       if (!p) continue;
       nus[n] = sensor_.residual(known[i].z, p->z);
       covs[n] = p->J_z_x * poses[n].cov * p->J_z_x.transpose() + p->J_z_m * L.cov * p->J_z_m.transpose() + p->Q;
@@ -324,7 +324,7 @@ auto FastSlam<Motion, Sensor, Map>::update_known_landmarks(Particle& particle, s
       outcomes.push_back(Outcome::gated);
       continue;
     }
-    const auto result = update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, false);
+    const auto result = update_landmark(particle, index_.at(known[i].landmark_id), known[i].z, known[i].noise_scale, false);
     particle.log_weight += result.log_likelihood;
     outcomes.push_back(result.outcome);
   }
@@ -399,7 +399,8 @@ auto FastSlam<Motion, Sensor, Map>::add_new_landmarks(std::vector<Particle>& par
     per_particle.clear();
     std::vector<LandmarkId> failed;
     for (const auto& particle : particles) {
-      const auto init = initialize_if_observable(sensor_, particle.x, observation.z, observation.landmark_id, failed);
+      const auto init = initialize_if_observable(sensor_, particle.x, observation.z, observation.landmark_id,
+                                                 observation.noise_scale, failed);
       if (!init) break;
       per_particle.push_back(
           {init->m, symmetrized(init->J_m_z * init->Q * init->J_m_z.transpose()), true, observation.landmark_id});
@@ -732,7 +733,7 @@ std::vector<std::size_t> FastSlam<Motion, Sensor, Map>::associate_and_propose(
 /// new-landmark gate's edge, with the measurement noise at pose x.
 template <class Motion, class Sensor, template <class> class Map>
 double FastSlam<Motion, Sensor, Map>::new_landmark_log_weight(const State& x, const Measurement& z) const {
-  const auto init = initialize_landmark(sensor_, x, z, LandmarkId{0});
+  const auto init = initialize_landmark(sensor_, x, z, LandmarkId{0}, 1.0);
   return log_gaussian(cholesky_or_throw(init.Q, "measurement noise"), Eigen::Matrix<double, Z, 1>::Zero().eval()) -
          0.5 * options_.new_landmark_nis;
 }
@@ -747,12 +748,12 @@ void FastSlam<Motion, Sensor, Map>::map_unassociated(Particle& particle, std::sp
   if (proposal) draw_into(particle, {particle.drawn_from, particle.drawn_cov}, t.rng);
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     if (match[i] != kNewLandmark) {
-      const double log_likelihood = update_landmark(particle, match[i], measurements[i], true).log_likelihood;
+      const double log_likelihood = update_landmark(particle, match[i], measurements[i], 1.0, true).log_likelihood;
       if (!proposal) particle.log_weight += log_likelihood;
       continue;
     }
     const LandmarkId id = t.next_unassociated_id + i;
-    const auto init = initialize_landmark(sensor_, particle.x, measurements[i], id);
+    const auto init = initialize_landmark(sensor_, particle.x, measurements[i], id, 1.0);
     particle.unassociated.push_back({init.m, symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose()), true, id});
     if (!proposal) particle.log_weight += new_landmark_log_weight(particle.x, measurements[i]);
   }

@@ -102,13 +102,14 @@ UpdateResult GraphSlam<Motion, Sensor>::update(std::span<const ObservationType> 
   std::vector<const ObservationType*> used;
   for (const auto& observation : known)
     if (linearize_if_observable(sensor_, poses_[pose], landmark_mean(landmarks_.slot(observation.landmark_id)),
-                                observation.z, observation.landmark_id, 0, result.unusable))
+                                observation.z, observation.landmark_id, 0, observation.noise_scale, result.unusable))
       used.push_back(&observation);
   std::vector<std::pair<const ObservationType*, LandmarkInit<M, X, Z>>> inits;
   for (const auto& observation : fresh) {
-    auto init = initialize_if_observable(sensor_, poses_[pose], observation.z, observation.landmark_id, result.unusable);
+    auto init = initialize_if_observable(sensor_, poses_[pose], observation.z, observation.landmark_id,
+                                         observation.noise_scale, result.unusable);
     if (!init || !linearize_if_observable(sensor_, poses_[pose], init->m, observation.z, observation.landmark_id, 0,
-                                          result.unusable))
+                                          observation.noise_scale, result.unusable))
       continue;
     require_factorizable_extension<M>(prior_.cov, init->J_m_x, symmetrized(init->J_m_z * init->Q * init->J_m_z.transpose()),
                                       "GraphSLAM: new landmark " + std::to_string(observation.landmark_id));
@@ -131,11 +132,11 @@ void GraphSlam<Motion, Sensor>::record_measurements(std::size_t pose, const std:
   std::vector<std::size_t> touched;
   for (const ObservationType* observation : used) {
     touched.push_back(landmarks_.slot(observation->landmark_id));
-    measurements_[touched.back()].push_back({pose, observation->z});
+    measurements_[touched.back()].push_back({pose, observation->z, observation->noise_scale});
   }
   for (const auto& [observation, init] : inits) {
     touched.push_back(landmarks_.add(observation->landmark_id, init.m));
-    measurements_.push_back({{pose, observation->z}});
+    measurements_.push_back({{pose, observation->z, observation->noise_scale}});
   }
   if (!options_.incremental) return;
   try {
@@ -309,12 +310,14 @@ void GraphSlam<Motion, Sensor>::add_marginal_factors(Linearization& sys) const {
 /// nu = residual(z, h(x, m)), Jacobians J_z_x, J_z_m (eqs. 62-63), down-weighted by the measurement
 /// loss; nothing where the model cannot predict it (e.g. an iterate put the landmark behind the camera).
 template <class Motion, class Sensor>
-auto GraphSlam<Motion, Sensor>::measurement_information(std::size_t slot, const Measurement& z, const State& x,
+auto GraphSlam<Motion, Sensor>::measurement_information(std::size_t slot, const MeasurementRecord& record, const State& x,
                                                         const Landmark& m) const -> std::optional<FactorInformation<X, M>> {
   const auto prediction = predict_if_observable(x, m);
   if (!prediction) return std::nullopt;
-  const GaussianNoise<Z> noise(prediction->Q, "measurement noise Q of landmark " + std::to_string(landmarks_.id_at(slot)));
-  return noise.information(prediction->J_z_x, prediction->J_z_m, sensor_.residual(z, prediction->z), options_.measurement_loss);
+  const GaussianNoise<Z> noise(with_noise_scale(*prediction, record.noise_scale).Q,
+                               "measurement noise Q of landmark " + std::to_string(landmarks_.id_at(slot)));
+  return noise.information(prediction->J_z_x, prediction->J_z_m, sensor_.residual(record.z, prediction->z),
+                           options_.measurement_loss);
 }
 
 /// Each measurement of each landmark (eqs. 62-63); one the model cannot evaluate sits this one out.
@@ -325,7 +328,7 @@ void GraphSlam<Motion, Sensor>::add_measurement_factors(Linearization& sys) cons
     terms.slot = slot;
     for (const auto& record : measurements_[slot]) {
       if (record.pose >= sys.pose_count) continue;
-      const auto info = measurement_information(slot, record.z, poses_[record.pose], landmark_mean(slot));
+      const auto info = measurement_information(slot, record, poses_[record.pose], landmark_mean(slot));
       if (!info) {
         ++sys.unobservable;
         continue;
@@ -512,7 +515,7 @@ void GraphSlam<Motion, Sensor>::reinitialize_after(std::size_t pose_count) {
   for (std::size_t slot = 0; slot < measurements_.size(); ++slot) {
     const auto& first = measurements_[slot].front();
     if (first.pose >= pose_count)
-      landmarks_.means().slot(slot) = initialize_landmark(sensor_, poses_[first.pose], first.z, landmarks_.id_at(slot)).m;
+      landmarks_.means().slot(slot) = initialize_landmark(sensor_, poses_[first.pose], first.z, landmarks_.id_at(slot), first.noise_scale).m;
   }
 }
 
@@ -598,7 +601,7 @@ auto GraphSlam<Motion, Sensor>::marginal_factor(std::size_t slot) const -> Linea
   Eigen::Matrix<double, M, M> A_jj = Eigen::Matrix<double, M, M>::Zero();
   Eigen::Matrix<double, M, 1> b_j = Eigen::Matrix<double, M, 1>::Zero();
   for (const auto& record : measurements_[slot]) {
-    const auto prediction = sensor_.predict(poses_[record.pose], landmark_mean(slot));
+    const auto prediction = with_noise_scale(sensor_.predict(poses_[record.pose], landmark_mean(slot)), record.noise_scale);
     const GaussianNoise<Z> noise(prediction.Q, "measurement noise Q of landmark " + std::to_string(id));
     const auto info = noise.information(prediction.J_z_x, prediction.J_z_m, sensor_.residual(record.z, prediction.z));
     terms.push_back({record.pose, info.aa, info.ab, info.a});

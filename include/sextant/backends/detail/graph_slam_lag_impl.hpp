@@ -112,7 +112,7 @@ void GraphSlam<Motion, Sensor>::add_lag_measurements(LagSys& sys, const LagEstim
   const Eigen::Index j = sys.landmark_at.at(slot);
   for (auto record = records.rbegin(); record != records.rend() && record->pose >= from; ++record) {
     if (record->pose > to) continue;
-    const auto info = measurement_information(slot, record->z, at.pose(record->pose), at.landmark(slot));
+    const auto info = measurement_information(slot, *record, at.pose(record->pose), at.landmark(slot));
     if (!info) continue;
     sys.add_factor(sys.pose_at.at(record->pose), j, *info);
   }

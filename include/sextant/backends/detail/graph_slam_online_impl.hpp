@@ -36,7 +36,7 @@ auto GraphSlam<Motion, Sensor>::linearize_landmark_online(std::size_t slot, cons
   const Landmark theta_j = plan.theta_landmarks.template segment<M>(M * static_cast<Eigen::Index>(slot));
   Eigen::Matrix<double, M, M> H = Eigen::Matrix<double, M, M>::Zero();
   for (const auto& record : measurements_[slot]) {
-    const auto info = measurement_information(slot, record.z, plan.theta[record.pose], theta_j);
+    const auto info = measurement_information(slot, record, plan.theta[record.pose], theta_j);
     if (!info) continue;
     lin.terms.push_back({record.pose, info->aa, info->ab, info->a});
     H += info->bb;

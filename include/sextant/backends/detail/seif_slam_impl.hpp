@@ -140,7 +140,8 @@ auto SeifSlam<Motion, Sensor>::measurement_information(const Linearized& lin) co
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::new_landmark(const ObservationType& observation, std::vector<LandmarkId>& unusable) const
     -> std::optional<NewLandmark> {
-  const auto initialized = initialize_if_observable(sensor_, x_, observation.z, observation.landmark_id, unusable);
+  const auto initialized = initialize_if_observable(sensor_, x_, observation.z, observation.landmark_id,
+                                                     observation.noise_scale, unusable);
   if (!initialized) return std::nullopt;
   const Init& init = *initialized;
   const Eigen::Matrix<double, M, M> C = symmetrized(init.J_m_z * init.Q * init.J_m_z.transpose());
