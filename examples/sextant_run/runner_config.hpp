@@ -64,7 +64,8 @@ struct GlobeSettings {
   bool tracker_exact_gate = false;
   int octave_layers = 4;            ///< globe-stereo, stereo:DIR: AKAZE's sublevels per octave (vision::DetectorOptions)
   double detector_threshold = 0.001;  ///< globe-stereo, stereo:DIR: AKAZE's response threshold
-  double min_disparity_sigmas = 0.0;  ///< globe-stereo, stereo:DIR: stereo matches within this many std of zero disparity dropped
+  double min_disparity_sigmas = 0.0;
+  bool slant_noise = false;  ///< globe-stereo, stereo:DIR: FrontEndOptions::slant_noise  ///< globe-stereo, stereo:DIR: stereo matches within this many std of zero disparity dropped
   bool row_search = false;  ///< [globe] stereo_correspondence = row_search: no detection in the right image
   bool pipelined = true;    ///< globe-stereo, stereo:DIR: frame k+1's front-end during frame k's filter half
   int opencv_threads = 1;   ///< globe-stereo, stereo:DIR: cv::setNumThreads during the run (0: OpenCV's default)
@@ -322,6 +323,10 @@ inline std::vector<ConfigKey> globe_stereo_keys() {
      "(sqrt(2) x the sensor's pixel noise) of zero are dropped, as points that cannot be told from one at infinity "
      "(0 keeps all; 2 drops below 1.41 px at 0.5 px noise)",
      [](RunnerConfig& c, const std::string& v) { c.globe.min_disparity_sigmas = non_negative(parse_number(v), v); }},
+    {"globe", "slant_noise", "false",
+     "globe-stereo, stereo:DIR: each stereo point's noise scaled by 1 / cos of the slant of the surface around it "
+     "(the plane through the points within 40 px), at most 10x: oblique features weigh less",
+     [](RunnerConfig& c, const std::string& v) { c.globe.slant_noise = parse_bool(v); }},
     {"globe", "stereo_correspondence", "detect_both",
      "globe-stereo, stereo:DIR: detect_both (AKAZE in both images, matched along the rows by descriptor) | "
      "row_search (AKAZE in the left image only, each keypoint found along its row in the right by correlation)",

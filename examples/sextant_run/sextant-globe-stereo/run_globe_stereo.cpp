@@ -67,6 +67,10 @@ void print_front_end(const FrontEndTotals& t, const vision::SequenceClock& clock
   if (truth)
     std::printf("; association precision %.4f (%zu of %zu right against the rendering)", truth->precision(),
                 truth->right(), truth->associated());
+  if (truth)
+    std::printf("; the right re-observations against the rendering under their stated noise: NIS mean %.2f, median %.2f, "
+                "%.1f%% inside 7.81 (3 dof), left keypoint %.2f px RMS from the true point",
+                truth->mean_nis(), truth->median_nis(), 100 * truth->share_of_nis_within(7.81), truth->pixel_rms());
   std::printf("\n%-12s %9s %9s %11s %10s %12s %9s %11s %10s\n", "ms/frame", "detect", "match", "triangulate",
               "associate", (tracker + " back-end").c_str(), "stages", "wall clock", "frames/s");
   const auto& s = t.times;
@@ -146,6 +150,7 @@ void draw_pipeline_picture(const std::filesystem::path& file, const PictureFrame
 vision::StereoTrackerOptions tracker_options(const RunnerConfig& c, const PointInCamera3D& sensor) {
   vision::StereoTrackerOptions o;
   o.front_end.min_disparity = vision::significant_disparity(sensor.noise.pixel_sigma, c.globe.min_disparity_sigmas);
+  o.front_end.slant_noise = c.globe.slant_noise;
   o.pool = c.globe.pool;
   o.association.max_observations = static_cast<std::size_t>(c.globe.features_per_frame);
   o.front_end.detector.octave_layers = c.globe.octave_layers;
