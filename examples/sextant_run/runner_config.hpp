@@ -65,7 +65,8 @@ struct GlobeSettings {
   int octave_layers = 4;            ///< globe-stereo, stereo:DIR: AKAZE's sublevels per octave (vision::DetectorOptions)
   double detector_threshold = 0.001;  ///< globe-stereo, stereo:DIR: AKAZE's response threshold
   double min_disparity_sigmas = 0.0;
-  bool slant_noise = false;  ///< globe-stereo, stereo:DIR: FrontEndOptions::slant_noise  ///< globe-stereo, stereo:DIR: stereo matches within this many std of zero disparity dropped
+  bool slant_noise = false;  ///< globe-stereo, stereo:DIR: FrontEndOptions::slant_noise
+  double new_landmark_density = 0.0;  ///< per m^3, globe-stereo, stereo:DIR: MapAssociationOptions::new_landmark_density  ///< globe-stereo, stereo:DIR: stereo matches within this many std of zero disparity dropped
   bool row_search = false;  ///< [globe] stereo_correspondence = row_search: no detection in the right image
   bool pipelined = true;    ///< globe-stereo, stereo:DIR: frame k+1's front-end during frame k's filter half
   int opencv_threads = 1;   ///< globe-stereo, stereo:DIR: cv::setNumThreads during the run (0: OpenCV's default)
@@ -327,6 +328,11 @@ inline std::vector<ConfigKey> globe_stereo_keys() {
      "globe-stereo, stereo:DIR: each stereo point's noise scaled by 1 / cos of the slant of the surface around it "
      "(the plane through the points within 40 px), at most 10x: oblique features weigh less",
      [](RunnerConfig& c, const std::string& v) { c.globe.slant_noise = parse_bool(v); }},
+    {"globe", "new_landmark_density", "0",
+     "globe-stereo, stereo:DIR: per m^3, how dense a new point is in view; a feature inside a landmark's gate that "
+     "matches no descriptor becomes a new landmark when that landmark's predictive density there is below this "
+     "(0: every gate keeps such a feature out)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.new_landmark_density = non_negative(parse_number(v), v); }},
     {"globe", "stereo_correspondence", "detect_both",
      "globe-stereo, stereo:DIR: detect_both (AKAZE in both images, matched along the rows by descriptor) | "
      "row_search (AKAZE in the left image only, each keypoint found along its row in the right by correlation)",

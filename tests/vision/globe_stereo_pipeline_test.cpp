@@ -405,6 +405,32 @@ TEST(MapAssociation, AFeaturesNoiseScaleWidensItsGate) {
   }
 }
 
+/// A feature inside a landmark's gate whose descriptor matches nothing is left out (it may be that
+/// landmark), unless the landmark is so uncertain that a new point is likelier (new_landmark_density):
+/// a landmark known to 100 m per axis (a wrong stereo match triangulated far away) has a predictive
+/// density of ~6e-8 per m^3 at its mean, below a new point's 10; one known to 1 cm has ~6e4 there.
+TEST(MapAssociation, OnlyALandmarkLikelierThanANewPointKeepsAnUnmatchedFeatureOut) {
+  const StereoFrame frame = hand_made_frame({{{0.001, 0, 1}, 0xFF}});
+  LandmarkAppearance appearance;
+  appearance.set(7, descriptor_of(0x00));
+  for (const double sigma : {100.0, 0.01})
+    for (const double density : {0.0, 10.0}) {
+      const std::vector<PredictedLandmark> predicted = {{7, {0, 0, 1}, Eigen::Matrix3d::Identity() / (sigma * sigma)}};
+      LandmarkId next = 100;
+      const auto a = associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance, next,
+                                      {.new_landmark_density = density});
+      const bool made_new = sigma > 1.0 && density > 0.0;
+      EXPECT_EQ(a.created, made_new ? 1u : 0u) << sigma << " m, density " << density;
+      EXPECT_EQ(a.gated_unmatched, made_new ? 0u : 1u) << sigma << " m, density " << density;
+    }
+  const std::vector<PredictedLandmark> none;
+  LandmarkId next = 100;
+  for (const double bad : {-1.0, std::numeric_limits<double>::quiet_NaN()})
+    EXPECT_THROW((void)associate_to_map(frame, std::span<const PredictedLandmark>(none), appearance, next,
+                                        {.new_landmark_density = bad}),
+                 invalid_input_error);
+}
+
 TEST(MapAssociation, GateThenDescriptorOneFeaturePerLandmark) {
   // Landmarks 7 and 8 predicted 1 mm apart, 1 cm standard deviation per axis: both gates hold
   // features 0, 1 and 3; feature 2 is in neither.

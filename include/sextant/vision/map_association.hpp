@@ -30,6 +30,12 @@ namespace sextant::vision {
 
 struct MapAssociationOptions {
   double gate_probability = 0.999;  ///< chi-square gate, 3 dof
+  /// Per m^3: how dense a new landmark's point is in the camera frame (1 / the volume where one can
+  /// appear). A feature inside a landmark's gate that matches no descriptor is left out rather than
+  /// made a new landmark, unless that landmark's predictive density there, N(z; z_hat, S), is below
+  /// this one: a landmark known only to decimetres (a far wrong match) then no longer blocks every
+  /// new one in view. 0: every gate blocks.
+  double new_landmark_density = 0.0;
   /// Largest descriptor distance of a pair: Hamming bits for AKAZE's 486-bit MLDB (unrelated
   /// patches differ in about half), L2 for KAZE's unit-length float descriptors (set it near 0.3).
   /// On the rendered globe (300 frames, docs/results/globe_stereo.md) 60 with the ratio test at 0.8
@@ -194,6 +200,15 @@ struct ScaledReach {
   bool may_hold(const Eigen::Vector3d& r, double s) const { return r.squaredNorm() <= 1.000001 * (state + s * s * noise); }
 };
 
+/// The NIS below which a feature inside the gate is more likely this landmark than a new point of
+/// the given density: N(z; z_hat, S) > density, i.e. NIS < -2 log density - log det S - 3 log 2 pi,
+/// and never beyond the gate. At density 0: the gate.
+inline double creation_blocking_nis(const Eigen::Matrix3d& S_inverse, double gate, double density) {
+  if (!(density > 0.0)) return gate;
+  const double log_det_S = -std::log(S_inverse.determinant());
+  return std::min(gate, -2.0 * std::log(density) - log_det_S - 3.0 * std::log(2.0 * std::acos(-1.0)));
+}
+
 /// Per feature, its nearest landmark descriptor among the landmarks whose gate it is inside, kept
 /// when within max_descriptor_distance and the ratio test against the second nearest; `gated[i]`:
 /// feature i is inside some gate. Each landmark tests only the features within its gate's reach
@@ -219,6 +234,7 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
   for (std::size_t j = 0; j < predicted.size(); ++j) {
     const cv::Mat* descriptor = appearance.find(predicted[j].id);
     const double reach = gate_reach(predicted[j].S_inverse_for(widest), gate), x = predicted[j].z.x();
+    const double blocking_nis = creation_blocking_nis(predicted[j].S_inverse, gate, o.new_landmark_density);
     const auto scaled = scaled_features ? std::optional<ScaledReach>(std::in_place, predicted[j], gate) : std::nullopt;
     for (const int feature : by_x.band(x, reach)) {
       const auto i = static_cast<std::size_t>(feature);
@@ -227,7 +243,7 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
       if (s != 1.0 && !scaled->may_hold(r, s)) continue;
       const double nis = s == 1.0 ? r.dot(predicted[j].S_inverse * r) : r.dot(predicted[j].S_inverse_for(s) * r);
       if (!(nis <= gate)) continue;
-      gated[i] = true;
+      gated[i] = gated[i] || nis <= blocking_nis;
       if (!descriptor) continue;
       const double distance = cv::norm(frame.descriptors.row(static_cast<int>(i)), *descriptor, norm);
       if (distance < best[i].distance) {
@@ -268,6 +284,9 @@ inline std::vector<int> one_to_one(std::vector<FeaturePair> pairs, std::size_t f
 inline FrameAssociation associate_to_map(const StereoFrame& frame, std::span<const PredictedLandmark> predicted,
                                          const LandmarkAppearance& appearance, LandmarkId& next_id,
                                          const MapAssociationOptions& o = {}) {
+  if (!(o.new_landmark_density >= 0.0))
+    throw invalid_input_error("map association: new_landmark_density " + std::to_string(o.new_landmark_density) +
+                              " per m^3 must be >= 0");
   std::vector<bool> gated;
   const auto landmark_of = detail::one_to_one(detail::gated_descriptor_matches(frame, predicted, appearance, o, gated),
                                               frame.features.size(), predicted.size());
