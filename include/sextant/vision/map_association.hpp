@@ -9,7 +9,6 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -68,10 +67,11 @@ struct PredictedLandmark {
   Eigen::Matrix3d state_part = Eigen::Matrix3d::Zero();  ///< H P H^T
   Eigen::Matrix3d Q = Eigen::Matrix3d::Zero();           ///< the model's measurement noise there
 
-  /// S^-1 for a feature of noise scale s.
+  /// S^-1 for a feature of noise scale s, solved with the Cholesky factor of S (positive definite:
+  /// Q is).
   Eigen::Matrix3d S_inverse_for(double s) const {
     if (s == 1.0 || Q.isZero(0.0)) return S_inverse;
-    return (state_part + s * s * Q).inverse();
+    return Eigen::LLT<Eigen::Matrix3d>(state_part + s * s * Q).solve(Eigen::Matrix3d::Identity());
   }
 };
 
@@ -241,7 +241,7 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
       const Eigen::Vector3d r = frame.features[i].point - predicted[j].z;
       const double s = frame.features[i].noise_scale;
       if (s != 1.0 && !scaled->may_hold(r, s)) continue;
-      const double nis = s == 1.0 ? r.dot(predicted[j].S_inverse * r) : r.dot(predicted[j].S_inverse_for(s) * r);
+      const double nis = r.dot(predicted[j].S_inverse_for(s) * r);
       if (!(nis <= gate)) continue;
       gated[i] = gated[i] || nis <= blocking_nis;
       if (!descriptor) continue;
