@@ -14,11 +14,11 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <span>
 #include <vector>
 
 #include "sextant/core/error.hpp"
+#include "sextant/vision/stereo_matching.hpp"
 
 namespace sextant::vision {
 
@@ -63,19 +63,18 @@ inline std::vector<double> slant_noise_scales(std::span<const Eigen::Vector2d> p
   if (pixels.size() != points.size())
     throw invalid_input_error("slant noise: " + std::to_string(pixels.size()) + " pixels for " +
                               std::to_string(points.size()) + " points");
-  std::vector<std::size_t> by_u(pixels.size());
-  std::iota(by_u.begin(), by_u.end(), std::size_t{0});
-  std::sort(by_u.begin(), by_u.end(), [&](std::size_t a, std::size_t b) { return pixels[a].x() < pixels[b].x(); });
-  std::vector<double> us(by_u.size());
-  for (std::size_t k = 0; k < by_u.size(); ++k) us[k] = pixels[by_u[k]].x();
+  std::vector<double> us;
+  us.reserve(pixels.size());
+  for (const auto& p : pixels) us.push_back(p.x());
+  const detail::SortedIndex by_u(us);
   std::vector<double> scales(points.size(), 1.0);
   std::vector<Eigen::Vector3d> near;
   const double r2 = o.radius_px * o.radius_px;
   for (std::size_t i = 0; i < points.size(); ++i) {
     near.clear();
-    const auto first = std::lower_bound(us.begin(), us.end(), pixels[i].x() - o.radius_px) - us.begin();
-    for (auto k = static_cast<std::size_t>(first); k < by_u.size() && us[k] <= pixels[i].x() + o.radius_px; ++k)
-      if ((pixels[by_u[k]] - pixels[i]).squaredNorm() <= r2) near.push_back(points[by_u[k]]);
+    for (const int k : by_u.band(pixels[i].x(), o.radius_px))
+      if ((pixels[static_cast<std::size_t>(k)] - pixels[i]).squaredNorm() <= r2)
+        near.push_back(points[static_cast<std::size_t>(k)]);
     if (near.size() < static_cast<std::size_t>(o.min_neighbours)) continue;
     const double cos_theta = std::abs(detail::plane_normal(near).dot(points[i].normalized()));
     scales[i] = std::min(o.max_scale, 1.0 / std::max(cos_theta, 1.0 / o.max_scale));
