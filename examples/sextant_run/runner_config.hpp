@@ -64,9 +64,9 @@ struct GlobeSettings {
   bool tracker_exact_gate = false;
   int octave_layers = 4;            ///< globe-stereo, stereo:DIR: AKAZE's sublevels per octave (vision::DetectorOptions)
   double detector_threshold = 0.001;  ///< globe-stereo, stereo:DIR: AKAZE's response threshold
-  double min_disparity_sigmas = 0.0;
+  double min_disparity_sigmas = 0.0;  ///< globe-stereo, stereo:DIR: stereo matches within this many std of zero disparity dropped
   bool slant_noise = false;  ///< globe-stereo, stereo:DIR: FrontEndOptions::slant_noise
-  double new_landmark_density = 0.0;  ///< per m^3, globe-stereo, stereo:DIR: MapAssociationOptions::new_landmark_density  ///< globe-stereo, stereo:DIR: stereo matches within this many std of zero disparity dropped
+  double new_landmark_density = 0.0;  ///< per m^3, globe-stereo, stereo:DIR: MapAssociationOptions::new_landmark_density
   bool row_search = false;  ///< [globe] stereo_correspondence = row_search: no detection in the right image
   bool pipelined = true;    ///< globe-stereo, stereo:DIR: frame k+1's front-end during frame k's filter half
   int opencv_threads = 1;   ///< globe-stereo, stereo:DIR: cv::setNumThreads during the run (0: OpenCV's default)
