@@ -67,6 +67,7 @@ struct GlobeSettings {
   double min_disparity_sigmas = 0.0;  ///< globe-stereo, stereo:DIR: stereo matches within this many std of zero disparity dropped
   bool slant_noise = false;  ///< globe-stereo, stereo:DIR: FrontEndOptions::slant_noise
   double new_landmark_density = 0.0;  ///< per m^3, globe-stereo, stereo:DIR: MapAssociationOptions::new_landmark_density
+  double student_t_dof = 0.0;  ///< globe-stereo, stereo:DIR: MapAssociationOptions::student_t_dof
   bool row_search = false;  ///< [globe] stereo_correspondence = row_search: no detection in the right image
   bool pipelined = true;    ///< globe-stereo, stereo:DIR: frame k+1's front-end during frame k's filter half
   int opencv_threads = 1;   ///< globe-stereo, stereo:DIR: cv::setNumThreads during the run (0: OpenCV's default)
@@ -333,6 +334,10 @@ inline std::vector<ConfigKey> globe_stereo_keys() {
      "matches no descriptor becomes a new landmark when that landmark's predictive density there is below this "
      "(0: every gate keeps such a feature out)",
      [](RunnerConfig& c, const std::string& v) { c.globe.new_landmark_density = non_negative(parse_number(v), v); }},
+    {"globe", "student_t_dof", "0",
+     "globe-stereo, stereo:DIR: a re-observation's error as a Student-t of this many degrees of freedom: its noise "
+     "scaled by sqrt((dof + NIS) / (dof + 3)) (0: Gaussian)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.student_t_dof = non_negative(parse_number(v), v); }},
     {"globe", "stereo_correspondence", "detect_both",
      "globe-stereo, stereo:DIR: detect_both (AKAZE in both images, matched along the rows by descriptor) | "
      "row_search (AKAZE in the left image only, each keypoint found along its row in the right by correlation)",

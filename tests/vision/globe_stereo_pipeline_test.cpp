@@ -405,6 +405,35 @@ TEST(MapAssociation, AFeaturesNoiseScaleWidensItsGate) {
   }
 }
 
+/// With student_t_dof = nu a re-observation's noise scale is its feature's times sqrt((nu + NIS) /
+/// (nu + 3)), NIS under the feature's own gate (H P H^T + s^2 Q): H P H^T = Q = 1e-4 I and a feature
+/// 0, 2 or 5 cm off gives NIS 0, 2 and 12.5 at s = 1; a new landmark keeps its feature's scale.
+TEST(MapAssociation, AReobservationsStudentTScaleFollowsItsInnovation) {
+  const Eigen::Matrix3d part = 1e-4 * Eigen::Matrix3d::Identity();
+  const std::vector<PredictedLandmark> predicted = {{7, {0, 0, 1}, (part + part).inverse(), part, part}};
+  LandmarkAppearance appearance;
+  appearance.set(7, descriptor_of(0x00));
+  for (const double feature_scale : {1.0, 2.0})
+    for (const double offset : {0.0, 0.02, 0.05}) {
+      StereoFrame frame = hand_made_frame({{{offset, 0, 1}, 0x00}, {{5, 0, 1}, 0x00}});
+      for (auto& f : frame.features) f.noise_scale = feature_scale;
+      LandmarkId next = 100;
+      const auto a = associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance, next,
+                                      {.student_t_dof = 4.0});
+      ASSERT_EQ(a.associated, 1u);
+      ASSERT_EQ(a.created, 1u);
+      const double nis = offset * offset / (1e-4 * (1.0 + feature_scale * feature_scale));
+      EXPECT_NEAR(a.observations[0].noise_scale, feature_scale * std::sqrt((4.0 + nis) / 7.0), 1e-12) << offset;
+      EXPECT_EQ(a.observations[1].noise_scale, feature_scale);  // the new landmark's
+    }
+  const StereoFrame frame = hand_made_frame({{{0.02, 0, 1}, 0x00}});
+  LandmarkId next = 100;
+  for (const double bad : {-1.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()})
+    EXPECT_THROW((void)associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance, next,
+                                        {.student_t_dof = bad}),
+                 invalid_input_error);
+}
+
 /// A feature inside a landmark's gate whose descriptor matches nothing is left out (it may be that
 /// landmark), unless the landmark is so uncertain that a new point is likelier (new_landmark_density):
 /// a landmark known to 100 m per axis (a wrong stereo match triangulated far away) has a predictive

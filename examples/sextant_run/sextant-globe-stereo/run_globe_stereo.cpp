@@ -154,6 +154,7 @@ vision::StereoTrackerOptions tracker_options(const RunnerConfig& c, const PointI
   o.pool = c.globe.pool;
   o.association.max_observations = static_cast<std::size_t>(c.globe.features_per_frame);
   o.association.new_landmark_density = c.globe.new_landmark_density;
+  o.association.student_t_dof = c.globe.student_t_dof;
   o.front_end.detector.octave_layers = c.globe.octave_layers;
   o.front_end.detector.threshold = static_cast<float>(c.globe.detector_threshold);
   if (c.globe.row_search) o.front_end.correspondence = vision::StereoCorrespondence::row_search;

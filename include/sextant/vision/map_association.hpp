@@ -4,7 +4,8 @@
 /// S = H Sigma H^T + Q at the joint marginal of the robot and the landmark, thesis eq. 15) and its
 /// descriptor is near the landmark's; among those pairs the nearest descriptors are taken first,
 /// one feature per landmark. A feature inside no landmark's gate becomes a new landmark; one inside
-/// a gate whose descriptor did not match is left out (it would duplicate a landmark).
+/// a gate whose descriptor did not match is left out (it would duplicate a landmark). A
+/// re-observation may state a noise of its own (a Student-t's weight, `student_t_dof`).
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -35,6 +36,12 @@ struct MapAssociationOptions {
   /// this one: a landmark known only to decimetres (a far wrong match) then no longer blocks every
   /// new one in view. 0: every gate blocks.
   double new_landmark_density = 0.0;
+  /// Degrees of freedom nu of a re-observation's error as a Student-t (a Gaussian N(0, Q / lambda)
+  /// with lambda ~ Gamma(nu/2, nu/2): heavy tails). Its noise is scaled by sqrt((nu + NIS) / (nu + 3)),
+  /// 1 / sqrt(E[lambda | innovation]) with the innovation taken as t-distributed with scale S (as in
+  /// Roth, Özkan and Gustafsson's t filter, 2013), applied to Q alone. A far re-observation weighs
+  /// less, a near one more. Nu = 4: Lange, Little and Taylor (JASA 1989). 0: Gaussian.
+  double student_t_dof = 0.0;
   /// Largest descriptor distance of a pair: Hamming bits for AKAZE's 486-bit MLDB (unrelated
   /// patches differ in about half), L2 for KAZE's unit-length float descriptors (set it near 0.3).
   /// On the rendered globe (300 frames, docs/results/globe_stereo.md) 60 with the ratio test at 0.8
@@ -277,6 +284,14 @@ inline std::vector<int> one_to_one(std::vector<FeaturePair> pairs, std::size_t f
   return landmark_of;
 }
 
+/// A re-observation's noise scale: the feature's, times the Student-t's where student_t_dof > 0.
+inline double reobservation_noise_scale(const StereoFeature& f, const PredictedLandmark& p, const MapAssociationOptions& o) {
+  if (!(o.student_t_dof > 0.0)) return f.noise_scale;
+  const Eigen::Vector3d r = f.point - p.z;
+  const double nis = r.dot(p.S_inverse_for(f.noise_scale) * r);
+  return f.noise_scale * std::sqrt((o.student_t_dof + nis) / (o.student_t_dof + 3.0));
+}
+
 }  // namespace detail
 
 /// Associates the frame's features with the predicted landmarks; new landmarks take ids
@@ -287,14 +302,17 @@ inline FrameAssociation associate_to_map(const StereoFrame& frame, std::span<con
   if (!(o.new_landmark_density >= 0.0))
     throw invalid_input_error("map association: new_landmark_density " + std::to_string(o.new_landmark_density) +
                               " per m^3 must be >= 0");
+  if (!(o.student_t_dof >= 0.0) || !std::isfinite(o.student_t_dof))
+    throw invalid_input_error("map association: student_t_dof " + std::to_string(o.student_t_dof) +
+                              " must be >= 0 and finite (0: Gaussian re-observations)");
   std::vector<bool> gated;
   const auto landmark_of = detail::one_to_one(detail::gated_descriptor_matches(frame, predicted, appearance, o, gated),
                                               frame.features.size(), predicted.size());
   FrameAssociation out;
   for (std::size_t i = 0; i < frame.features.size() && out.observations.size() < o.max_observations; ++i) {
     if (landmark_of[i] < 0) continue;
-    out.observations.push_back(
-        {predicted[static_cast<std::size_t>(landmark_of[i])].id, frame.features[i].point, frame.features[i].noise_scale});
+    const PredictedLandmark& p = predicted[static_cast<std::size_t>(landmark_of[i])];
+    out.observations.push_back({p.id, frame.features[i].point, detail::reobservation_noise_scale(frame.features[i], p, o)});
     out.feature.push_back(i);
     ++out.associated;
   }
