@@ -269,27 +269,27 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
 }
 
 /// One landmark per feature and one feature per landmark, the closest descriptors first (ties: the
-/// smaller innovation); -1 for a feature left without one.
-inline std::vector<int> one_to_one(std::vector<FeaturePair> pairs, std::size_t features, std::size_t landmarks) {
+/// smaller innovation): per feature the pair it took, empty for a feature left without one.
+inline std::vector<std::optional<FeaturePair>> one_to_one(std::vector<FeaturePair> pairs, std::size_t features,
+                                                          std::size_t landmarks) {
   std::sort(pairs.begin(), pairs.end(), [](const FeaturePair& a, const FeaturePair& b) {
     return a.distance != b.distance ? a.distance < b.distance : a.nis < b.nis;
   });
-  std::vector<int> landmark_of(features, -1);
+  std::vector<std::optional<FeaturePair>> taken_by(features);
   std::vector<bool> taken(landmarks, false);
   for (const FeaturePair& p : pairs) {
-    if (landmark_of[p.feature] >= 0 || taken[p.landmark]) continue;
-    landmark_of[p.feature] = static_cast<int>(p.landmark);
+    if (taken_by[p.feature] || taken[p.landmark]) continue;
+    taken_by[p.feature] = p;
     taken[p.landmark] = true;
   }
-  return landmark_of;
+  return taken_by;
 }
 
-/// A re-observation's noise scale: the feature's, times the Student-t's where student_t_dof > 0.
-inline double reobservation_noise_scale(const StereoFeature& f, const PredictedLandmark& p, const MapAssociationOptions& o) {
-  if (!(o.student_t_dof > 0.0)) return f.noise_scale;
-  const Eigen::Vector3d r = f.point - p.z;
-  const double nis = r.dot(p.S_inverse_for(f.noise_scale) * r);
-  return f.noise_scale * std::sqrt((o.student_t_dof + nis) / (o.student_t_dof + 3.0));
+/// A re-observation's noise scale: the feature's, times the Student-t's where student_t_dof > 0
+/// (`nis`: the pair's, under the feature's own gate).
+inline double reobservation_noise_scale(double feature_scale, double nis, const MapAssociationOptions& o) {
+  if (!(o.student_t_dof > 0.0)) return feature_scale;
+  return feature_scale * std::sqrt((o.student_t_dof + nis) / (o.student_t_dof + 3.0));
 }
 
 }  // namespace detail
@@ -306,18 +306,18 @@ inline FrameAssociation associate_to_map(const StereoFrame& frame, std::span<con
     throw invalid_input_error("map association: student_t_dof " + std::to_string(o.student_t_dof) +
                               " must be >= 0 and finite (0: Gaussian re-observations)");
   std::vector<bool> gated;
-  const auto landmark_of = detail::one_to_one(detail::gated_descriptor_matches(frame, predicted, appearance, o, gated),
-                                              frame.features.size(), predicted.size());
+  const auto pair_of = detail::one_to_one(detail::gated_descriptor_matches(frame, predicted, appearance, o, gated),
+                                          frame.features.size(), predicted.size());
   FrameAssociation out;
   for (std::size_t i = 0; i < frame.features.size() && out.observations.size() < o.max_observations; ++i) {
-    if (landmark_of[i] < 0) continue;
-    const PredictedLandmark& p = predicted[static_cast<std::size_t>(landmark_of[i])];
-    out.observations.push_back({p.id, frame.features[i].point, detail::reobservation_noise_scale(frame.features[i], p, o)});
+    if (!pair_of[i]) continue;
+    const double scale = detail::reobservation_noise_scale(frame.features[i].noise_scale, pair_of[i]->nis, o);
+    out.observations.push_back({predicted[pair_of[i]->landmark].id, frame.features[i].point, scale});
     out.feature.push_back(i);
     ++out.associated;
   }
   for (std::size_t i = 0; i < frame.features.size(); ++i) {
-    if (landmark_of[i] >= 0) continue;
+    if (pair_of[i]) continue;
     if (gated[i]) {
       ++out.gated_unmatched;
       continue;
