@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "sextant/core/error.hpp"
-#include "sextant/vision/stereo_matching.hpp"
+#include "sextant/vision/pixel_neighbours.hpp"
 
 namespace sextant::vision {
 
@@ -63,18 +63,14 @@ inline std::vector<double> slant_noise_scales(std::span<const Eigen::Vector2d> p
   if (pixels.size() != points.size())
     throw invalid_input_error("slant noise: " + std::to_string(pixels.size()) + " pixels for " +
                               std::to_string(points.size()) + " points");
-  std::vector<double> us;
-  us.reserve(pixels.size());
-  for (const auto& p : pixels) us.push_back(p.x());
-  const detail::SortedIndex by_u(us);
+  const detail::PixelNeighbours neighbours(pixels);
   std::vector<double> scales(points.size(), 1.0);
+  std::vector<int> indices;
   std::vector<Eigen::Vector3d> near;
-  const double r2 = o.radius_px * o.radius_px;
   for (std::size_t i = 0; i < points.size(); ++i) {
+    neighbours.within(i, o.radius_px, indices);
     near.clear();
-    for (const int k : by_u.band(pixels[i].x(), o.radius_px))
-      if ((pixels[static_cast<std::size_t>(k)] - pixels[i]).squaredNorm() <= r2)
-        near.push_back(points[static_cast<std::size_t>(k)]);
+    for (const int k : indices) near.push_back(points[static_cast<std::size_t>(k)]);
     if (near.size() < static_cast<std::size_t>(o.min_neighbours)) continue;
     const double cos_theta = std::abs(detail::plane_normal(near).dot(points[i].normalized()));
     scales[i] = std::min(o.max_scale, 1.0 / std::max(cos_theta, 1.0 / o.max_scale));
