@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "sextant/vision/disparity_support.hpp"
 #include "sextant/vision/features.hpp"
 #include "sextant/vision/row_search_matching.hpp"
 #include "sextant/vision/slant_noise.hpp"
@@ -38,6 +39,10 @@ struct FrontEndOptions {
   /// disparity on the rendered globe becomes a landmark 170 m deep that the sparse filters' mean
   /// recovery cannot hold (docs/results/real_time.md, "A disparity floor").
   double min_disparity = 0.0;
+  /// A match is dropped when its disparity is not borne out by its neighbours' (vision/disparity_support.hpp),
+  /// judged among the matches the floor keeps: a wrong match far off the surface never becomes a landmark.
+  bool disparity_support = false;
+  DisparitySupportOptions support{};
   /// Each point's noise scaled by 1 / cos of the slant of the surface around it (vision/slant_noise.hpp):
   /// features seen obliquely weigh less instead of being dropped or trusted as frontal ones.
   bool slant_noise = false;
@@ -62,6 +67,7 @@ struct StereoFrame {
   cv::Mat descriptors;                  ///< row i: the left descriptor of features[i]
   std::size_t left_keypoints = 0, right_keypoints = 0;
   std::size_t below_min_disparity = 0;  ///< matches dropped by FrontEndOptions::min_disparity
+  std::size_t without_support = 0;      ///< matches dropped by FrontEndOptions::disparity_support
   FrontEndTimes times;
 };
 
@@ -73,6 +79,7 @@ class StereoFrontEnd {
       throw invalid_input_error("stereo front-end: min_disparity " + std::to_string(options.min_disparity) +
                                 " px must be finite and >= 0");
     if (options.slant_noise) require_valid(options.slant);
+    if (options.disparity_support) require_valid(options.support);
   }
 
   const StereoRig& rig() const { return rig_; }
@@ -133,6 +140,7 @@ class StereoFrontEnd {
   void triangulate_matches(std::vector<StereoMatch>& matches, const Features& left, StereoFrame& out) const {
     const auto too_small = [&](const StereoMatch& m) { return m.disparity() < options_.min_disparity; };
     out.below_min_disparity = static_cast<std::size_t>(std::erase_if(matches, too_small));
+    if (options_.disparity_support) out.without_support = drop_unsupported(matches);
     out.features.reserve(matches.size());
     out.descriptors.create(static_cast<int>(matches.size()), left.descriptors.cols, left.descriptors.type());
     for (std::size_t i = 0; i < matches.size(); ++i) {
@@ -142,6 +150,15 @@ class StereoFrontEnd {
       left.descriptors.row(m.left).copyTo(out.descriptors.row(static_cast<int>(i)));
     }
     if (options_.slant_noise) scale_noise_by_slant(out.features);
+  }
+
+  std::size_t drop_unsupported(std::vector<StereoMatch>& matches) const {
+    std::vector<Eigen::Vector2d> pixels;
+    std::vector<double> disparities;
+    for (const auto& m : matches) pixels.push_back(m.left_px), disparities.push_back(m.disparity());
+    const auto kept = disparity_supported(pixels, disparities, options_.support);
+    std::size_t i = 0;
+    return static_cast<std::size_t>(std::erase_if(matches, [&](const StereoMatch&) { return !kept[i++]; }));
   }
 
   void scale_noise_by_slant(std::vector<StereoFeature>& features) const {

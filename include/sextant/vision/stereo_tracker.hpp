@@ -52,6 +52,7 @@ struct TrackedFrame {
   std::vector<bool> is_new;                                ///< per observation: it proposed a new landmark
   std::size_t left_keypoints = 0, right_keypoints = 0, stereo_matches = 0, predicted = 0, gated_unmatched = 0;
   std::size_t below_min_disparity = 0;  ///< stereo matches the front-end dropped (FrontEndOptions::min_disparity)
+  std::size_t without_support = 0;      ///< and dropped for want of support (FrontEndOptions::disparity_support)
   UpdateResult update;
   TrackerTimes times;
 };
@@ -98,6 +99,7 @@ class StereoTracker {
     out.right_keypoints = frame.right_keypoints;
     out.stereo_matches = frame.features.size();
     out.below_min_disparity = frame.below_min_disparity;
+    out.without_support = frame.without_support;
     auto start = Clock::now();
     backend_.predict(control, dt);
     out.times.backend = seconds_since(start);
