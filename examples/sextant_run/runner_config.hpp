@@ -66,6 +66,7 @@ struct GlobeSettings {
   double detector_threshold = 0.001;  ///< globe-stereo, stereo:DIR: AKAZE's response threshold
   double min_disparity_sigmas = 0.0;  ///< globe-stereo, stereo:DIR: stereo matches within this many std of zero disparity dropped
   bool slant_noise = false;  ///< globe-stereo, stereo:DIR: FrontEndOptions::slant_noise
+  bool disparity_support = false;  ///< globe-stereo, stereo:DIR: FrontEndOptions::disparity_support
   double new_landmark_density = 0.0;  ///< per m^3, globe-stereo, stereo:DIR: MapAssociationOptions::new_landmark_density
   double student_t_dof = 0.0;  ///< globe-stereo, stereo:DIR: MapAssociationOptions::student_t_dof
   bool row_search = false;  ///< [globe] stereo_correspondence = row_search: no detection in the right image
@@ -329,6 +330,11 @@ inline std::vector<ConfigKey> globe_stereo_keys() {
      "globe-stereo, stereo:DIR: each stereo point's noise scaled by 1 / cos of the slant of the surface around it "
      "(the plane through the points within 40 px), at most 10x: oblique features weigh less",
      [](RunnerConfig& c, const std::string& v) { c.globe.slant_noise = parse_bool(v); }},
+    {"globe", "disparity_support", "false",
+     "globe-stereo, stereo:DIR: a stereo match is dropped when its disparity lies more than 4 standard deviations "
+     "from the one predicted by the plane fitted (robustly) to the disparities of the 6 or more others within 40 px "
+     "(a wrong match off the surface around it)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.disparity_support = parse_bool(v); }},
     {"globe", "new_landmark_density", "0",
      "globe-stereo, stereo:DIR: per m^3, how dense a new point is in view; a feature inside a landmark's gate that "
      "matches no descriptor becomes a new landmark when that landmark's predictive density there is below this "

@@ -35,7 +35,7 @@ using Observations = std::vector<Observation<Eigen::Vector3d>>;
 /// Sums over the frames of a run: the front-end's figures and the time per stage.
 struct FrontEndTotals {
   std::size_t frames = 0, left_keypoints = 0, stereo_matches = 0, observations = 0, associated = 0, created = 0;
-  std::size_t below_min_disparity = 0;
+  std::size_t below_min_disparity = 0, without_support = 0;
   double min_disparity = 0.0;  ///< px, the front-end's floor
   vision::TrackerTimes times;
   double render = 0.0;
@@ -45,6 +45,7 @@ struct FrontEndTotals {
     left_keypoints += f.left_keypoints;
     stereo_matches += f.stereo_matches;
     below_min_disparity += f.below_min_disparity;
+    without_support += f.without_support;
     observations += f.observations.size();
     for (bool is_new : f.is_new) ++(is_new ? created : associated);
     times.detect += f.times.detect;
@@ -64,9 +65,14 @@ void print_front_end(const FrontEndTotals& t, const vision::SequenceClock& clock
   if (t.min_disparity > 0)
     std::printf("; %zu stereo matches in all dropped below the disparity floor (%.2f px, %g standard deviations)",
                 t.below_min_disparity, t.min_disparity, settings.min_disparity_sigmas);
+  if (settings.disparity_support)
+    std::printf("; %zu dropped for want of support from their neighbours' disparities", t.without_support);
   if (truth)
     std::printf("; association precision %.4f (%zu of %zu right against the rendering)", truth->precision(),
                 truth->right(), truth->associated());
+  if (truth)
+    std::printf("; %zu of %zu new landmarks from wrong stereo matches against the rendering",
+                truth->new_from_wrong_matches(), truth->created());
   if (truth)
     std::printf("; the right re-observations against the rendering under their stated noise: NIS mean %.2f, median %.2f, "
                 "%.1f%% inside 7.81 (3 dof), left keypoint %.2f px RMS from the true point",
@@ -146,11 +152,14 @@ void draw_pipeline_picture(const std::filesystem::path& file, const PictureFrame
   if (!cv::imwrite(file.string(), canvas)) throw invalid_input_error(file.string() + ": cannot be written");
 }
 
-/// The tracker's settings from [globe]; the disparity floor in standard deviations of the sensor's pixel noise.
+/// The tracker's settings from [globe]; the disparity floor in standard deviations of the sensor's
+/// pixel noise, which is also the disparity support test's least scatter about a plane.
 vision::StereoTrackerOptions tracker_options(const RunnerConfig& c, const PointInCamera3D& sensor) {
   vision::StereoTrackerOptions o;
   o.front_end.min_disparity = vision::significant_disparity(sensor.noise.pixel_sigma, c.globe.min_disparity_sigmas);
   o.front_end.slant_noise = c.globe.slant_noise;
+  o.front_end.disparity_support = c.globe.disparity_support;
+  o.front_end.support.min_sigma_px = vision::significant_disparity(sensor.noise.pixel_sigma, 1.0);
   o.pool = c.globe.pool;
   o.association.max_observations = static_cast<std::size_t>(c.globe.features_per_frame);
   o.association.new_landmark_density = c.globe.new_landmark_density;

@@ -28,7 +28,7 @@ class GlobeAssociationTruth {
       const LandmarkId id = frame.observations[k].landmark_id;
       const vision::StereoFeature& f = frame.observed[k];
       if (frame.is_new[k]) {
-        if (const auto m = sim::surface_point(options_, x, f.left_px.x(), f.left_px.y())) true_points_.emplace(id, *m);
+        add_new(x, id, frame.observations[k], f);
         continue;
       }
       ++associated_;
@@ -58,6 +58,11 @@ class GlobeAssociationTruth {
   /// Root mean square of the left keypoint's offset from the true point's projection [px].
   double pixel_rms() const { return nis_.empty() ? 0.0 : std::sqrt(pixel_sq_sum_ / static_cast<double>(nis_.size())); }
 
+  /// New landmarks from a wrong stereo match: the surface behind the right keypoint, seen from the
+  /// left camera, lies outside the left keypoint's support (its radius, at least 2 px), or either
+  /// keypoint shows no globe (the criterion of tests/vision/stereo_front_end_test.cpp).
+  std::size_t new_from_wrong_matches() const { return new_from_wrong_matches_; }
+  std::size_t created() const { return created_; }
   std::size_t associated() const { return associated_; }
   std::size_t right() const { return right_; }
   double precision() const { return associated_ ? static_cast<double>(right_) / static_cast<double>(associated_) : 1.0; }
@@ -68,9 +73,9 @@ class GlobeAssociationTruth {
   bool seen_at(const Vector12d& x, const Eigen::Vector3d& m, const vision::StereoFeature& f) const {
     const Eigen::Vector3d p = x.head<3>();
     if (m.dot(p - m) <= 0.0) return false;  // on the far hemisphere
-    const Eigen::Vector3d q = euler_yxz::rotation(x.segment<3>(3)).transpose() * (m - p);
+    const Eigen::Vector3d q = in_camera(x, m);
     if (q.z() <= 0.0) return false;
-    return (left_pixel(q) - f.left_px).norm() <= std::max(0.5 * f.size, 2.0);
+    return (left_pixel(q) - f.left_px).norm() <= support(f);
   }
 
   Eigen::Vector2d left_pixel(const Eigen::Vector3d& q) const {
@@ -78,10 +83,24 @@ class GlobeAssociationTruth {
     return {0.5 * options_.image_width + f_px * q.x() / q.z(), 0.5 * options_.image_height + f_px * q.y() / q.z()};
   }
 
+  void add_new(const Vector12d& x, LandmarkId id, const Observation<Eigen::Vector3d>& o, const vision::StereoFeature& f) {
+    ++created_;
+    const auto m = sim::surface_point(options_, x, f.left_px.x(), f.left_px.y());
+    if (m) true_points_.emplace(id, *m);
+    const auto seen_right = sim::surface_point(options_, x, f.right_px.x(), f.right_px.y(), sim::StereoSide::right);
+    const bool right = m && seen_right && (left_pixel(in_camera(x, *seen_right)) - f.left_px).norm() <= support(f);
+    new_from_wrong_matches_ += !right;
+  }
+
+  static Eigen::Vector3d in_camera(const Vector12d& x, const Eigen::Vector3d& world) {
+    return euler_yxz::rotation(x.segment<3>(3)).transpose() * (world - x.head<3>());
+  }
+  static double support(const vision::StereoFeature& f) { return std::max(0.5 * f.size, 2.0); }
+
   /// The observation's error against the true point m seen from x, weighed by its stated noise.
   void add_error(const Vector12d& x, const Eigen::Vector3d& m, const Observation<Eigen::Vector3d>& o,
                  const vision::StereoFeature& f) {
-    const Eigen::Vector3d q = euler_yxz::rotation(x.segment<3>(3)).transpose() * (m - x.head<3>());
+    const Eigen::Vector3d q = in_camera(x, m);
     const Eigen::Vector3d e = o.z - q;
     const Eigen::Matrix3d stated = o.noise_scale * o.noise_scale * options_.stereo.covariance(q);
     const double nis = e.dot(stated.ldlt().solve(e));
@@ -94,7 +113,7 @@ class GlobeAssociationTruth {
   double nis_sum_ = 0.0, pixel_sq_sum_ = 0.0;
   std::vector<double> nis_;
   std::map<LandmarkId, Eigen::Vector3d> true_points_;
-  std::size_t associated_ = 0, right_ = 0;
+  std::size_t associated_ = 0, right_ = 0, created_ = 0, new_from_wrong_matches_ = 0;
 };
 
 }  // namespace sextant::eval
