@@ -332,8 +332,8 @@ inline std::vector<ConfigKey> globe_stereo_keys() {
      [](RunnerConfig& c, const std::string& v) { c.globe.slant_noise = parse_bool(v); }},
     {"globe", "disparity_support", "false",
      "globe-stereo, stereo:DIR: a stereo match is dropped when its disparity lies more than 4 standard deviations "
-     "from the one predicted by the plane fitted (robustly) to the disparities of the 6 or more others within 40 px "
-     "(a wrong match off the surface around it)",
+     "from the one predicted by the plane fitted (robustly) to the disparities of the others within 40 px (the radius "
+     "doubled up to 160 px while they are fewer than 6): a wrong match off the surface around it",
      [](RunnerConfig& c, const std::string& v) { c.globe.disparity_support = parse_bool(v); }},
     {"globe", "new_landmark_density", "0",
      "globe-stereo, stereo:DIR: per m^3, how dense a new point is in view; a feature inside a landmark's gate that "

@@ -259,9 +259,10 @@ TEST(StereoFrontEnd, TheFrontEndsSlantFollowsTheGlobesSurface) {
 /// A plane's matches on a grid 10 px apart (disparity 100 + 0.2 u px), a patch of a nearer surface
 /// in one corner (disparity 180, a depth edge), a match alone: all kept. Wrong matches planted inside
 /// the grid are dropped: disparity 1.7 px (as the one that lost the camera on seed 7), 400 px, 8 px
-/// too much (8 of the disparity's noise floor of 1 px, twice the interval's 4), and two side by
-/// side that agree with each other (the robust step leaves each out of the other's plane). Options
-/// out of range, lists of different lengths, a NaN disparity: refused.
+/// too much (8 of the disparity's noise floor of 1 px, twice the interval's 4), two side by side that
+/// agree with each other (the robust step leaves each out of the other's plane), and one 60 px right
+/// of the grid, alone within 40 px (judged on the doubled radius). Options out of range, lists of
+/// different lengths, a NaN disparity: refused.
 TEST(StereoFrontEnd, AMatchWhoseDisparityItsNeighboursDoNotBearOutIsDropped) {
   std::vector<Eigen::Vector2d> pixels;
   std::vector<double> disparities;
@@ -274,7 +275,7 @@ TEST(StereoFrontEnd, AMatchWhoseDisparityItsNeighboursDoNotBearOutIsDropped) {
   disparities.push_back(3.0);
   const std::size_t honest = pixels.size();
   for (const auto& [u, v, d] : {std::tuple{155.0, 155.0, 1.7}, {205.0, 175.0, 400.0}, {225.0, 185.0, 100.0 + 0.2 * 225.0 + 8.0},
-                                {245.0, 205.0, 9.0}, {246.0, 206.0, 9.5}}) {
+                                {245.0, 205.0, 9.0}, {246.0, 206.0, 9.5}, {350.0, 170.0, 20.0}}) {
     pixels.emplace_back(u, v);
     disparities.push_back(d);
   }
@@ -290,7 +291,8 @@ TEST(StereoFrontEnd, AMatchWhoseDisparityItsNeighboursDoNotBearOutIsDropped) {
   for (const DisparitySupportOptions bad :
        {DisparitySupportOptions{.radius_px = 0.0}, DisparitySupportOptions{.min_neighbours = 3},
         DisparitySupportOptions{.sigmas = -1.0}, DisparitySupportOptions{.min_sigma_px = 0.0},
-        DisparitySupportOptions{.sigmas = std::numeric_limits<double>::infinity()}}) {
+        DisparitySupportOptions{.sigmas = std::numeric_limits<double>::infinity()},
+        DisparitySupportOptions{.max_radius_px = 39.0}}) {
     EXPECT_THROW((void)disparity_supported(std::vector<Eigen::Vector2d>(2), two, bad), invalid_input_error);
     EXPECT_THROW(StereoFrontEnd(StereoRig{}, {.disparity_support = true, .support = bad}), invalid_input_error);
   }
@@ -336,8 +338,8 @@ TEST(StereoFrontEnd, TheDisparitySupportTestDropsMatchesFarOffTheGlobeAndKeepsTh
     for (std::size_t i = 0; i < pixels.size(); i += 10) {  // one at a time among the frame's own matches
       if (!is_right[i]) continue;
       ++planted;
-      neighbours.within(i, o.radius_px, near);
-      if (static_cast<int>(near.size()) - 1 < o.min_neighbours) continue;
+      (void)detail::neighbourhood(neighbours, i, o, near);
+      if (static_cast<int>(near.size()) < o.min_neighbours) continue;
       ++planted_judged;
       std::vector<double> corrupted = disparities;
       const double share = static_cast<double>((i * 7919) % 1000) / 1000.0;  // spread over [0, 1)

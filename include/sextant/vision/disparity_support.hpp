@@ -11,7 +11,10 @@
 /// when its disparity lies outside the fit's prediction interval, `sigmas` x s sqrt(1 + h) with s the
 /// neighbours' scatter about the plane (at least the matching noise) and h the leverage of p_i. A
 /// neighbourhood that no plane fits (a depth edge, a curved or broken surface) has a wide scatter and
-/// judges leniently; one with too few neighbours, or all on a line, is not judged.
+/// judges leniently. A match with too few neighbours within the radius is judged on a radius doubled
+/// until it has them, up to a largest radius: the wrong matches are often alone, in the strip at the
+/// left image's edge whose true partners lie beyond the right image's (on the rendered globe: 36-116 px
+/// off, with no other match within 40 px). One still short of neighbours, or with all on a line, is not judged.
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -30,19 +33,21 @@ namespace sextant::vision {
 
 struct DisparitySupportOptions {
   double radius_px = 40.0;   ///< the neighbourhood in the left image
-  int min_neighbours = 6;    ///< fewer other matches within the radius (or left after the robust step): not judged
+  double max_radius_px = 160.0;  ///< radius_px doubled up to this while the neighbours are fewer than min_neighbours
+  int min_neighbours = 6;    ///< fewer other matches within max_radius_px (or left after the robust step): not judged
   double sigmas = 4.0;       ///< the prediction interval's half-width in the fit's standard deviations
   double min_sigma_px = 1.0; ///< the scatter about the plane is taken as at least this (the disparity's own noise)
 };
 
-/// Throws invalid_input_error unless radius_px, sigmas and min_sigma_px are positive and finite and
-/// min_neighbours >= 4 (a plane has three parameters; one more leaves a scatter).
+/// Throws invalid_input_error unless radius_px, sigmas and min_sigma_px are positive and finite,
+/// max_radius_px finite and >= radius_px, and min_neighbours >= 4 (a plane has three parameters; one
+/// more leaves a scatter).
 inline void require_valid(const DisparitySupportOptions& o) {
   const auto positive_finite = [](double v) { return v > 0.0 && std::isfinite(v); };
   if (!positive_finite(o.radius_px) || !positive_finite(o.sigmas) || !positive_finite(o.min_sigma_px) ||
-      o.min_neighbours < 4)
+      !(o.max_radius_px >= o.radius_px) || !std::isfinite(o.max_radius_px) || o.min_neighbours < 4)
     throw invalid_input_error("disparity support: radius_px, sigmas and min_sigma_px must be positive and finite, "
-                              "min_neighbours >= 4");
+                              "max_radius_px finite and >= radius_px, min_neighbours >= 4");
 }
 
 namespace detail {
@@ -101,6 +106,17 @@ inline double median_of_absolute(std::vector<double> values) {
   return *middle;
 }
 
+/// The other matches within radius_px of match i, the radius doubled (at most to max_radius_px) while
+/// they are fewer than min_neighbours; returns the radius used.
+inline double neighbourhood(const PixelNeighbours& neighbours, std::size_t i, const DisparitySupportOptions& o,
+                            std::vector<int>& others) {
+  for (double radius = o.radius_px;; radius = std::min(2.0 * radius, o.max_radius_px)) {
+    neighbours.within(i, radius, others);
+    std::erase(others, static_cast<int>(i));
+    if (static_cast<int>(others.size()) >= o.min_neighbours || radius >= o.max_radius_px) return radius;
+  }
+}
+
 /// The second, robust fit: the neighbours within `sigmas` robust deviations (1.4826 x the median
 /// absolute residual, at least min_sigma_px) of the first fit; nothing when too few are left.
 inline std::optional<LocalPlane> robust_plane(const LocalPlaneFit& fitter, std::size_t i, std::span<const int> others,
@@ -121,7 +137,8 @@ inline std::optional<LocalPlane> robust_plane(const LocalPlaneFit& fitter, std::
 
 /// For each match (left keypoint `pixels[i]`, disparity `disparities[i]`), whether it is kept: its
 /// disparity lies within the prediction interval of the plane fitted to its neighbours' (those within
-/// radius_px), or it is not judged (too few neighbours, on a line, or too few left by the robust step).
+/// radius_px, or a wider radius up to max_radius_px where they are too few), or it is not judged (too
+/// few neighbours even so, on a line, or too few left by the robust step).
 /// Throws invalid_input_error for options out of range (require_valid), lists of different lengths,
 /// or a disparity that is not finite.
 inline std::vector<bool> disparity_supported(std::span<const Eigen::Vector2d> pixels, std::span<const double> disparities,
@@ -133,14 +150,12 @@ inline std::vector<bool> disparity_supported(std::span<const Eigen::Vector2d> pi
   for (const double d : disparities)
     if (!std::isfinite(d)) throw invalid_input_error("disparity support: a disparity is not finite");
   const detail::PixelNeighbours neighbours(pixels);
-  const detail::LocalPlaneFit fitter(pixels, disparities, o.radius_px);
   std::vector<bool> kept(pixels.size(), true);
   std::vector<int> others;
   for (std::size_t i = 0; i < pixels.size(); ++i) {
-    neighbours.within(i, o.radius_px, others);
-    std::erase(others, static_cast<int>(i));
+    const double radius = detail::neighbourhood(neighbours, i, o, others);
     if (static_cast<int>(others.size()) < o.min_neighbours) continue;
-    const auto plane = detail::robust_plane(fitter, i, others, o);
+    const auto plane = detail::robust_plane(detail::LocalPlaneFit(pixels, disparities, radius), i, others, o);
     if (!plane) continue;
     const double s = std::max(o.min_sigma_px, plane->scatter);
     kept[i] = std::abs(disparities[i] - plane->coefficients(0)) <= o.sigmas * s * std::sqrt(1.0 + plane->leverage);
