@@ -28,7 +28,7 @@ class GlobeAssociationTruth {
       const LandmarkId id = frame.observations[k].landmark_id;
       const vision::StereoFeature& f = frame.observed[k];
       if (frame.is_new[k]) {
-        add_new(x, id, frame.observations[k], f);
+        add_new(x, id, f);
         continue;
       }
       ++associated_;
@@ -83,7 +83,8 @@ class GlobeAssociationTruth {
     return {0.5 * options_.image_width + f_px * q.x() / q.z(), 0.5 * options_.image_height + f_px * q.y() / q.z()};
   }
 
-  void add_new(const Vector12d& x, LandmarkId id, const Observation<Eigen::Vector3d>& o, const vision::StereoFeature& f) {
+  /// Keeps a new landmark's true point and scores its stereo match (new_from_wrong_matches).
+  void add_new(const Vector12d& x, LandmarkId id, const vision::StereoFeature& f) {
     ++created_;
     const auto m = sim::surface_point(options_, x, f.left_px.x(), f.left_px.y());
     if (m) true_points_.emplace(id, *m);

@@ -13,6 +13,7 @@
 
 namespace sextant::vision::detail {
 
+/// Holds a view of the pixels: they must outlive it.
 class PixelNeighbours {
  public:
   explicit PixelNeighbours(std::span<const Eigen::Vector2d> pixels) : pixels_(pixels), by_u_(columns(pixels)) {}

@@ -152,13 +152,19 @@ class StereoFrontEnd {
     if (options_.slant_noise) scale_noise_by_slant(out.features);
   }
 
+  /// Drops the matches whose disparity their neighbours' plane does not predict; returns how many.
   std::size_t drop_unsupported(std::vector<StereoMatch>& matches) const {
     std::vector<Eigen::Vector2d> pixels;
     std::vector<double> disparities;
     for (const auto& m : matches) pixels.push_back(m.left_px), disparities.push_back(m.disparity());
     const auto kept = disparity_supported(pixels, disparities, options_.support);
-    std::size_t i = 0;
-    return static_cast<std::size_t>(std::erase_if(matches, [&](const StereoMatch&) { return !kept[i++]; }));
+    std::vector<StereoMatch> supported;
+    supported.reserve(matches.size());
+    for (std::size_t i = 0; i < matches.size(); ++i)
+      if (kept[i]) supported.push_back(matches[i]);
+    const std::size_t dropped = matches.size() - supported.size();
+    matches = std::move(supported);
+    return dropped;
   }
 
   void scale_noise_by_slant(std::vector<StereoFeature>& features) const {
