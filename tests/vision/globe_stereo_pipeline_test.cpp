@@ -75,10 +75,11 @@ void expect_tracks_the_camera(Backend backend, const sim::GlobeCameraOptions& o,
     times.backend += frame.times.backend;
     truth.score(x, frame);
     EXPECT_LE(frame.observations.size(), MapAssociationOptions{}.max_observations);
-    created += static_cast<std::size_t>(std::count(frame.is_new.begin(), frame.is_new.end(), true));
+    const auto new_here = static_cast<std::size_t>(std::count(frame.is_new.begin(), frame.is_new.end(), true));
+    created += new_here;
     if (k >= 5) {
       later_observations += frame.observations.size();
-      later_new += static_cast<std::size_t>(std::count(frame.is_new.begin(), frame.is_new.end(), true));
+      later_new += new_here;
     }
     position_error += (pose_mean_of(tracker.backend()).template head<3>() - x.head<3>()).norm();
   }
@@ -87,11 +88,12 @@ void expect_tracks_the_camera(Backend backend, const sim::GlobeCameraOptions& o,
               "position MAE %.2f mm (EKF on the point simulator, same trajectory: %.2f mm); ms per frame: association "
               "%.1f, back-end %.1f; %zu of %zu new landmarks from wrong stereo matches\n",
               name, o.num_steps, truth.associated(), truth.precision(), later_new, later_observations, 1e3 * mae,
-              1e3 * point_mae, 1e3 * times.associate / o.num_steps, 1e3 * times.backend / o.num_steps, truth.new_from_wrong_matches(), truth.created());
+              1e3 * point_mae, 1e3 * times.associate / o.num_steps, 1e3 * times.backend / o.num_steps,
+              truth.new_from_wrong_matches(), truth.created());
   EXPECT_GE(truth.precision(), 0.99);
   // Every new landmark scored. Those from wrong stereo matches are printed, not bounded: a wrong match
   // seldom falls in a landmark's gate, so they are many times the share of wrong matches in a frame
-  // (docs/results/real_time.md, "Wrong matches become new landmarks").
+  // (docs/results/real_time.md, "Wrong stereo matches become new landmarks").
   EXPECT_EQ(truth.created(), created);
   EXPECT_LE(mae, 2.0 * point_mae);
   // Once the map holds the globe's visible side, most observations are re-observations: without

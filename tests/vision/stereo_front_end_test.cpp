@@ -31,25 +31,16 @@ struct RenderedPair {
   explicit RenderedPair(const Vector12d& x) : pose(x), images(sim::render_stereo(options, pose)) {}
   RenderedPair() : RenderedPair(sim::detail::orbit_start(sim::GlobeCameraOptions{})) {}
 
-  Eigen::Vector3d in_camera(const Eigen::Vector3d& world) const {
-    return euler_yxz::rotation(pose.segment<3>(3)).transpose() * (world - pose.head<3>());
-  }
-  Eigen::Vector2d left_pixel(const Eigen::Vector3d& q) const {
-    return {rig.cx + rig.focal_px * q.x() / q.z(), rig.cy + rig.focal_px * q.y() / q.z()};
-  }
+  Eigen::Vector3d in_camera(const Eigen::Vector3d& world) const { return sim::in_left_camera(pose, world); }
   /// The true point in the left camera frame behind a left pixel, if the pixel shows the globe.
   std::optional<Eigen::Vector3d> true_point(const Eigen::Vector2d& left_px) const {
     const auto m = sim::surface_point(options, pose, left_px.x(), left_px.y());
     if (!m) return std::nullopt;
     return in_camera(*m);
   }
-  /// A match is right when the surface point behind its right keypoint, seen from the left camera,
-  /// falls inside the left keypoint's support (its radius, at least 2 px): both keypoints then
-  /// describe the same patch of the globe.
+  /// The rendering's answer key (sim::stereo_match_is_right).
   bool is_right(const StereoMatch& m, float left_size) const {
-    const auto seen_right = sim::surface_point(options, pose, m.right_px.x(), m.right_px.y(), sim::StereoSide::right);
-    if (!seen_right) return false;
-    return (left_pixel(in_camera(*seen_right)) - m.left_px).norm() <= std::max(0.5 * left_size, 2.0);
+    return sim::stereo_match_is_right(options, pose, m.left_px, m.right_px, left_size);
   }
 };
 

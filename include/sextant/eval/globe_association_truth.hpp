@@ -58,9 +58,8 @@ class GlobeAssociationTruth {
   /// Root mean square of the left keypoint's offset from the true point's projection [px].
   double pixel_rms() const { return nis_.empty() ? 0.0 : std::sqrt(pixel_sq_sum_ / static_cast<double>(nis_.size())); }
 
-  /// New landmarks from a wrong stereo match: the surface behind the right keypoint, seen from the
-  /// left camera, lies outside the left keypoint's support (its radius, at least 2 px), or either
-  /// keypoint shows no globe (the criterion of tests/vision/stereo_front_end_test.cpp).
+  /// New landmarks from a wrong stereo match (sim::stereo_match_is_right false) or whose left
+  /// keypoint shows no globe.
   std::size_t new_from_wrong_matches() const { return new_from_wrong_matches_; }
   std::size_t created() const { return created_; }
   std::size_t associated() const { return associated_; }
@@ -73,14 +72,9 @@ class GlobeAssociationTruth {
   bool seen_at(const Vector12d& x, const Eigen::Vector3d& m, const vision::StereoFeature& f) const {
     const Eigen::Vector3d p = x.head<3>();
     if (m.dot(p - m) <= 0.0) return false;  // on the far hemisphere
-    const Eigen::Vector3d q = in_camera(x, m);
+    const Eigen::Vector3d q = sim::in_left_camera(x, m);
     if (q.z() <= 0.0) return false;
-    return (left_pixel(q) - f.left_px).norm() <= support(f);
-  }
-
-  Eigen::Vector2d left_pixel(const Eigen::Vector3d& q) const {
-    const double f_px = options_.stereo.focal_px;
-    return {0.5 * options_.image_width + f_px * q.x() / q.z(), 0.5 * options_.image_height + f_px * q.y() / q.z()};
+    return (sim::left_pixel(options_, q) - f.left_px).norm() <= std::max(0.5 * f.size, 2.0);
   }
 
   /// Keeps a new landmark's true point and scores its stereo match (new_from_wrong_matches).
@@ -88,26 +82,19 @@ class GlobeAssociationTruth {
     ++created_;
     const auto m = sim::surface_point(options_, x, f.left_px.x(), f.left_px.y());
     if (m) true_points_.emplace(id, *m);
-    const auto seen_right = sim::surface_point(options_, x, f.right_px.x(), f.right_px.y(), sim::StereoSide::right);
-    const bool right = m && seen_right && (left_pixel(in_camera(x, *seen_right)) - f.left_px).norm() <= support(f);
-    new_from_wrong_matches_ += !right;
+    new_from_wrong_matches_ += !(m && sim::stereo_match_is_right(options_, x, f.left_px, f.right_px, f.size));
   }
-
-  static Eigen::Vector3d in_camera(const Vector12d& x, const Eigen::Vector3d& world) {
-    return euler_yxz::rotation(x.segment<3>(3)).transpose() * (world - x.head<3>());
-  }
-  static double support(const vision::StereoFeature& f) { return std::max(0.5 * f.size, 2.0); }
 
   /// The observation's error against the true point m seen from x, weighed by its stated noise.
   void add_error(const Vector12d& x, const Eigen::Vector3d& m, const Observation<Eigen::Vector3d>& o,
                  const vision::StereoFeature& f) {
-    const Eigen::Vector3d q = in_camera(x, m);
+    const Eigen::Vector3d q = sim::in_left_camera(x, m);
     const Eigen::Vector3d e = o.z - q;
     const Eigen::Matrix3d stated = o.noise_scale * o.noise_scale * options_.stereo.covariance(q);
     const double nis = e.dot(stated.ldlt().solve(e));
     nis_sum_ += nis;
     nis_.push_back(nis);
-    pixel_sq_sum_ += (left_pixel(q) - f.left_px).squaredNorm();
+    pixel_sq_sum_ += (sim::left_pixel(options_, q) - f.left_px).squaredNorm();
   }
 
   sim::GlobeCameraOptions options_;

@@ -7,6 +7,7 @@
 /// true surface point behind any pixel is known (surface_point), hence every feature's true 3D point.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -163,6 +164,25 @@ inline std::optional<Eigen::Vector3d> surface_point(const GlobeCameraOptions& o,
   const auto t = detail::ray_meets_sphere(centre, d, o.globe_radius);
   if (!t) return std::nullopt;
   return Eigen::Vector3d(centre + *t * d);
+}
+
+/// A world point in the left camera's frame at pose x (x right, y down, z forward).
+inline Eigen::Vector3d in_left_camera(const Vector12d& x, const Eigen::Vector3d& world) {
+  return euler_yxz::rotation(x.segment<3>(3)).transpose() * (world - x.head<3>());
+}
+
+/// The left image's pixel of a point q in the left camera's frame (z > 0).
+inline Eigen::Vector2d left_pixel(const GlobeCameraOptions& o, const Eigen::Vector3d& q) {
+  return {0.5 * o.image_width + o.stereo.focal_px * q.x() / q.z(), 0.5 * o.image_height + o.stereo.focal_px * q.y() / q.z()};
+}
+
+/// The rendering's answer key for a stereo match seen from pose x: right when the surface behind its
+/// right keypoint, seen from the left camera, falls inside the left keypoint's support (its radius,
+/// at least 2 px), so both keypoints describe the same patch of the globe.
+inline bool stereo_match_is_right(const GlobeCameraOptions& o, const Vector12d& x, const Eigen::Vector2d& left_px,
+                                  const Eigen::Vector2d& right_px, double left_size) {
+  const auto seen_right = surface_point(o, x, right_px.x(), right_px.y(), StereoSide::right);
+  return seen_right && (left_pixel(o, in_left_camera(x, *seen_right)) - left_px).norm() <= std::max(0.5 * left_size, 2.0);
 }
 
 }  // namespace sextant::sim
