@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "backend_factory.hpp"
 #include "globe_runs.hpp"
 #include "dataset_registry.hpp"
 #include "progress_bar.hpp"
@@ -171,25 +172,26 @@ vision::StereoTrackerOptions tracker_options(const RunnerConfig& c, const PointI
   return o;
 }
 
-/// Calls `run(tracker, name)` with the stereo tracker of [globe] tracker: the EKF with [ekf]'s
-/// options, SEIF with [seif]'s and the first [globe] seif_active value, or ESEIF (relocalizing) with
-/// the first eseif_active value.
+/// Calls `run(tracker, name)` with the stereo tracker of [globe] tracker: the EKF, SEIF with the
+/// first [globe] seif_active value, or ESEIF (relocalizing) with the first eseif_active value, each
+/// configured as the table's run of that back-end is (backend_choices: [ekf] and [seif] with the
+/// 12D camera's observability constraints where the config leaves them automatic).
 template <class Run>
 auto with_tracker(const RunnerConfig& c, const EulerCamera12D& motion, const PointInCamera3D& sensor,
                   const Gaussian<Vector12d, 12>& prior, const vision::StereoRig& rig, int width, int height, Run&& run) {
+  const BackendChoice choice = backend_choices<EulerCamera12D>({c.globe.tracker}, c).front();
   if (c.globe.tracker == BackendKind::seif || c.globe.tracker == BackendKind::eseif) {
     const bool relocalizing = c.globe.tracker == BackendKind::eseif;
     const auto& active = relocalizing ? c.globe.eseif_active : c.globe.seif_active;
     const std::string key = relocalizing ? "eseif" : "seif";
     if (active.empty()) throw invalid_input_error("[globe] tracker = " + key + " needs a [globe] " + key + "_active value");
-    SeifOptions seif = c.seif;
+    SeifOptions seif = choice.seif;
     seif.max_active = active.front();
-    if (relocalizing) seif.sparsification = SeifSparsification::relocalization;
     vision::StereoTracker<SeifSlam<EulerCamera12D, PointInCamera3D>> tracker(
         {motion, sensor, prior, seif}, sensor, rig, width, height, tracker_options(c, sensor));
     return run(tracker, std::string(seif.sparsification == SeifSparsification::relocalization ? "ESEIF" : "SEIF"));
   }
-  vision::StereoTracker<EkfSlam<EulerCamera12D, PointInCamera3D>> tracker({motion, sensor, prior, c.ekf}, sensor,
+  vision::StereoTracker<EkfSlam<EulerCamera12D, PointInCamera3D>> tracker({motion, sensor, prior, choice.ekf}, sensor,
                                                                            rig, width, height, tracker_options(c, sensor));
   return run(tracker, std::string("EKF"));
 }
