@@ -289,6 +289,13 @@ inline std::vector<ConfigKey> globe_keys() {
      [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_landmarks = parse_integer<std::size_t>(v, 1, 1e6); }},
     {"globe", "max_new_per_step", "50", "new landmarks per step at most (thesis: 50)",
      [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_new_per_step = parse_integer<std::size_t>(v, 1, 1e6); }},
+    {"globe", "pool_eviction", "least_recently_seen",
+     "which landmarks make room in a full pool: least_recently_seen (thesis) | fewest_sightings (seen in the fewest "
+     "steps first: tracked points stay for the loop)",
+     [](RunnerConfig& c, const std::string& v) {
+       c.globe.pool.eviction = parse_choice<PoolEviction>(
+           v, {{"least_recently_seen", PoolEviction::least_recently_seen}, {"fewest_sightings", PoolEviction::fewest_sightings}});
+     }},
     {"globe", "seif_active", "150 250 0", "SEIF runs, one per value: active landmarks (0 = all)",
      [](RunnerConfig& c, const std::string& v) { c.globe.seif_active = parse_active_counts(v, false); }},
     {"globe", "eseif_active", "150 250",

@@ -51,6 +51,32 @@ TEST(LandmarkPoolPolicy, EvictsTheLeastRecentlySeenSmallerIdFirstAndNeverOneSeen
   EXPECT_EQ(policy.history().back().in_pool, 4u);
 }
 
+TEST(LandmarkPoolPolicy, FewestSightingsEvictsTheLandmarkSeenInTheFewestStepsFirst) {
+  LandmarkPoolPolicy policy({.max_landmarks = 4, .max_new_per_step = 4, .eviction = PoolEviction::fewest_sightings});
+  auto commit = [&](std::vector<Obs> observations, std::size_t step) {
+    const auto plan = policy.plan(std::span<const Obs>(observations));
+    policy.commit(plan, step);
+    return plan;
+  };
+  commit(observe({10, 11}), 0);
+  commit(observe({10}), 1);
+  commit(observe({10}), 2);
+  commit(observe({12, 13}), 3);
+  // 10 seen at three steps, 11, 12 and 13 at one; the least recently seen first among equals (11),
+  // then the smaller id (12). The thesis's order would have taken 11 and 10.
+  const auto plan = commit(observe({14, 15}), 4);
+  EXPECT_EQ(plan.evict, (std::vector<LandmarkId>{11, 12}));
+  EXPECT_TRUE(policy.contains(10) && policy.contains(13) && policy.contains(14) && policy.contains(15));
+  // A landmark seen twice in one step counts one step: 13 and 14 (one step each, 13 the older)
+  // against 15 (steps 4 and 5) and 10 (three steps).
+  commit(observe({15}), 5);
+  commit(observe({15}), 5);
+  EXPECT_EQ(commit(observe({20}), 6).evict, (std::vector<LandmarkId>{13}));
+  EXPECT_EQ(commit(observe({21}), 7).evict, (std::vector<LandmarkId>{14}));
+  EXPECT_EQ(commit(observe({22}), 8).evict, (std::vector<LandmarkId>{20}));
+  EXPECT_TRUE(policy.contains(10) && policy.contains(15));
+}
+
 TEST(LandmarkPoolPolicy, AdmitsNewLandmarksInTheGivenOrderUpToThePerStepLimit) {
   LandmarkPoolPolicy policy({.max_landmarks = 100, .max_new_per_step = 2});
   const auto observations = observe({5, 3, 9, 1});
@@ -72,29 +98,31 @@ TEST(LandmarkPoolPolicy, NeverExceedsCapacityOrThePerStepLimitOnARandomStream) {
   std::mt19937_64 rng(3);
   std::uniform_int_distribution<LandmarkId> id(0, 300);
   std::uniform_int_distribution<int> count(0, 40);
-  const PoolLimits limits{.max_landmarks = 60, .max_new_per_step = 7};
-  LandmarkPoolPolicy policy(limits);
-  std::set<LandmarkId> pool;
-  for (std::size_t step = 0; step < 2000; ++step) {
-    std::set<LandmarkId> ids;
-    const int n = count(rng);
-    while (static_cast<int>(ids.size()) < n) ids.insert(id(rng));
-    std::vector<Obs> observations;
-    for (LandmarkId i : ids) observations.push_back({i, Eigen::Vector2d::Zero()});
-    std::shuffle(observations.begin(), observations.end(), rng);
-    const auto plan = policy.plan(std::span<const Obs>(observations));
-    for (LandmarkId e : plan.evict) {
-      ASSERT_EQ(pool.erase(e), 1u) << "evicted a landmark not in the pool";
-      ASSERT_FALSE(ids.contains(e)) << "evicted a landmark observed in this step";
+  for (const PoolEviction eviction : {PoolEviction::least_recently_seen, PoolEviction::fewest_sightings}) {
+    const PoolLimits limits{.max_landmarks = 60, .max_new_per_step = 7, .eviction = eviction};
+    LandmarkPoolPolicy policy(limits);
+    std::set<LandmarkId> pool;
+    for (std::size_t step = 0; step < 2000; ++step) {
+      std::set<LandmarkId> ids;
+      const int n = count(rng);
+      while (static_cast<int>(ids.size()) < n) ids.insert(id(rng));
+      std::vector<Obs> observations;
+      for (LandmarkId i : ids) observations.push_back({i, Eigen::Vector2d::Zero()});
+      std::shuffle(observations.begin(), observations.end(), rng);
+      const auto plan = policy.plan(std::span<const Obs>(observations));
+      for (LandmarkId e : plan.evict) {
+        ASSERT_EQ(pool.erase(e), 1u) << "evicted a landmark not in the pool";
+        ASSERT_FALSE(ids.contains(e)) << "evicted a landmark observed in this step";
+      }
+      std::size_t added = 0;
+      for (const auto& o : plan.observations) added += pool.insert(o.landmark_id).second;
+      ASSERT_EQ(added, plan.added);
+      ASSERT_LE(added, limits.max_new_per_step);
+      ASSERT_LE(pool.size(), limits.max_landmarks);
+      policy.commit(plan, step);
+      ASSERT_EQ(policy.size(), pool.size());
+      ASSERT_EQ(policy.history().back().in_pool, pool.size());
     }
-    std::size_t added = 0;
-    for (const auto& o : plan.observations) added += pool.insert(o.landmark_id).second;
-    ASSERT_EQ(added, plan.added);
-    ASSERT_LE(added, limits.max_new_per_step);
-    ASSERT_LE(pool.size(), limits.max_landmarks);
-    policy.commit(plan, step);
-    ASSERT_EQ(policy.size(), pool.size());
-    ASSERT_EQ(policy.history().back().in_pool, pool.size());
   }
 }
 

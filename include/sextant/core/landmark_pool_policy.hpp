@@ -1,7 +1,8 @@
 #pragma once
 /// \file The thesis's bounded landmark pool (seed 000, §4.2.2: P.Mmax and P.max_lm_inc_per_step):
 /// at most max_landmarks in the state, at most max_new_per_step added per step, and when full the
-/// least recently seen landmarks are evicted to make room. The policy only decides; each back-end
+/// least recently seen landmarks are evicted to make room (or those seen in the fewest steps,
+/// PoolEviction). The policy only decides; each back-end
 /// removes by its own rule through remove_landmark (EKF: rows and columns deleted; SEIF and
 /// GraphSLAM: marginalization; FastSLAM: from every particle).
 
@@ -11,6 +12,8 @@
 #include <set>
 #include <span>
 #include <string>
+#include <tuple>
+#include <type_traits>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -23,9 +26,19 @@
 
 namespace sextant {
 
+/// Which landmarks make room when the pool is full; never one observed in the step.
+enum class PoolEviction {
+  least_recently_seen,  ///< the thesis's: the oldest last sighting first (ties: the smaller id)
+  /// The landmark seen in the fewest steps first (ties: the least recently seen, then the smaller
+  /// id): a point tracked over many frames stays for when the camera comes back (a loop), while
+  /// points seen once or twice, most of an image front-end's new ones, make the room.
+  fewest_sightings,
+};
+
 struct PoolLimits {
   std::size_t max_landmarks = 1000;   ///< Mmax
   std::size_t max_new_per_step = 50;  ///< max_lm_inc_per_step
+  PoolEviction eviction = PoolEviction::least_recently_seen;
 };
 
 /// Bookkeeping of one step (the thesis's Figures 22 and 25).
@@ -58,8 +71,8 @@ class LandmarkPoolPolicy {
 
   /// Plans one step without changing the policy: observations of landmarks in the pool pass; new
   /// ones are admitted in the order given (a front-end lists its strongest first) up to
-  /// max_new_per_step and up to what eviction can free; the landmarks to evict are the least
-  /// recently seen (ties: the smaller id first), never one observed in this step.
+  /// max_new_per_step and up to what eviction can free; the landmarks to evict come in the order
+  /// PoolLimits::eviction names, never one observed in this step.
   template <class Measurement>
   PoolPlan<Measurement> plan(std::span<const Observation<Measurement>> observations) const {
     require_valid_observations(observations);  // the back-ends' own check: finite, no id twice
@@ -82,8 +95,16 @@ class LandmarkPoolPolicy {
     out.added = admit;
     out.refused = fresh.size() - admit;
     const std::size_t over = size() + admit > limits_.max_landmarks ? size() + admit - limits_.max_landmarks : 0;
-    for (auto it = by_age_.begin(); out.evict.size() < over && it != by_age_.end(); ++it)
-      if (!seen_now.contains(it->second)) out.evict.push_back(it->second);
+    auto evict_in_order = [&](const auto& order) {  // each entry's id is its last element
+      for (auto it = order.begin(); out.evict.size() < over && it != order.end(); ++it) {
+        const LandmarkId id = std::get<std::tuple_size_v<std::decay_t<decltype(*it)>> - 1>(*it);
+        if (!seen_now.contains(id)) out.evict.push_back(id);
+      }
+    };
+    if (limits_.eviction == PoolEviction::fewest_sightings)
+      evict_in_order(by_sightings_);
+    else
+      evict_in_order(by_age_);
     return out;
   }
 
@@ -108,21 +129,29 @@ class LandmarkPoolPolicy {
   }
 
  private:
+  struct Sightings {
+    std::size_t last = 0, count = 0;
+  };
   void forget(LandmarkId id) {
     const auto it = last_seen_.find(id);
     if (it == last_seen_.end()) return;
-    by_age_.erase({it->second, id});
+    by_age_.erase({it->second.last, id});
+    by_sightings_.erase({it->second.count, it->second.last, id});
     last_seen_.erase(it);
   }
   void see(LandmarkId id, std::size_t step) {
+    const auto it = last_seen_.find(id);
+    const std::size_t count = it == last_seen_.end() ? 1 : it->second.count + (step != it->second.last);
     forget(id);
-    last_seen_.emplace(id, step);
+    last_seen_.emplace(id, Sightings{step, count});
     by_age_.emplace(step, id);
+    by_sightings_.emplace(count, step, id);
   }
 
   PoolLimits limits_;
-  std::unordered_map<LandmarkId, std::size_t> last_seen_;
+  std::unordered_map<LandmarkId, Sightings> last_seen_;
   std::set<std::pair<std::size_t, LandmarkId>> by_age_;  ///< (last seen, id): the oldest first
+  std::set<std::tuple<std::size_t, std::size_t, LandmarkId>> by_sightings_;  ///< (steps seen, last seen, id)
   std::vector<PoolStepRecord> history_;
 };
 
