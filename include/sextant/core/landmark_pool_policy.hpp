@@ -13,7 +13,6 @@
 #include <span>
 #include <string>
 #include <tuple>
-#include <type_traits>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -65,8 +64,8 @@ class LandmarkPoolPolicy {
   }
 
   const PoolLimits& limits() const { return limits_; }
-  std::size_t size() const { return last_seen_.size(); }
-  bool contains(LandmarkId id) const { return last_seen_.contains(id); }
+  std::size_t size() const { return sightings_.size(); }
+  bool contains(LandmarkId id) const { return sightings_.contains(id); }
   const std::vector<PoolStepRecord>& history() const { return history_; }
 
   /// Plans one step without changing the policy: observations of landmarks in the pool pass; new
@@ -95,16 +94,8 @@ class LandmarkPoolPolicy {
     out.added = admit;
     out.refused = fresh.size() - admit;
     const std::size_t over = size() + admit > limits_.max_landmarks ? size() + admit - limits_.max_landmarks : 0;
-    auto evict_in_order = [&](const auto& order) {  // each entry's id is its last element
-      for (auto it = order.begin(); out.evict.size() < over && it != order.end(); ++it) {
-        const LandmarkId id = std::get<std::tuple_size_v<std::decay_t<decltype(*it)>> - 1>(*it);
-        if (!seen_now.contains(id)) out.evict.push_back(id);
-      }
-    };
-    if (limits_.eviction == PoolEviction::fewest_sightings)
-      evict_in_order(by_sightings_);
-    else
-      evict_in_order(by_age_);
+    for (auto it = eviction_order_.begin(); out.evict.size() < over && it != eviction_order_.end(); ++it)
+      if (!seen_now.contains(std::get<2>(*it))) out.evict.push_back(std::get<2>(*it));
     return out;
   }
 
@@ -130,28 +121,31 @@ class LandmarkPoolPolicy {
 
  private:
   struct Sightings {
-    std::size_t last = 0, count = 0;
+    std::size_t last = 0;   ///< the step it was last seen at
+    std::size_t steps = 0;  ///< how many steps it was seen at
   };
+  /// (steps seen, or 0 for the thesis's order; last seen; id): the first to make room first.
+  using EvictionKey = std::tuple<std::size_t, std::size_t, LandmarkId>;
+  EvictionKey eviction_key(LandmarkId id, const Sightings& s) const {
+    return {limits_.eviction == PoolEviction::fewest_sightings ? s.steps : 0, s.last, id};
+  }
   void forget(LandmarkId id) {
-    const auto it = last_seen_.find(id);
-    if (it == last_seen_.end()) return;
-    by_age_.erase({it->second.last, id});
-    by_sightings_.erase({it->second.count, it->second.last, id});
-    last_seen_.erase(it);
+    const auto it = sightings_.find(id);
+    if (it == sightings_.end()) return;
+    eviction_order_.erase(eviction_key(id, it->second));
+    sightings_.erase(it);
   }
   void see(LandmarkId id, std::size_t step) {
-    const auto it = last_seen_.find(id);
-    const std::size_t count = it == last_seen_.end() ? 1 : it->second.count + (step != it->second.last);
+    const auto it = sightings_.find(id);
+    const Sightings seen{step, it == sightings_.end() ? 1 : it->second.steps + (step != it->second.last)};
     forget(id);
-    last_seen_.emplace(id, Sightings{step, count});
-    by_age_.emplace(step, id);
-    by_sightings_.emplace(count, step, id);
+    sightings_.emplace(id, seen);
+    eviction_order_.insert(eviction_key(id, seen));
   }
 
   PoolLimits limits_;
-  std::unordered_map<LandmarkId, Sightings> last_seen_;
-  std::set<std::pair<std::size_t, LandmarkId>> by_age_;  ///< (last seen, id): the oldest first
-  std::set<std::tuple<std::size_t, std::size_t, LandmarkId>> by_sightings_;  ///< (steps seen, last seen, id)
+  std::unordered_map<LandmarkId, Sightings> sightings_;
+  std::set<EvictionKey> eviction_order_;
   std::vector<PoolStepRecord> history_;
 };
 
