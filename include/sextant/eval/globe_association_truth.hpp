@@ -74,7 +74,7 @@ class GlobeAssociationTruth {
     if (m.dot(p - m) <= 0.0) return false;  // on the far hemisphere
     const Eigen::Vector3d q = sim::in_left_camera(x, m);
     if (q.z() <= 0.0) return false;
-    return (sim::left_pixel(options_, q) - f.left_px).norm() <= std::max(0.5 * f.size, 2.0);
+    return (sim::left_pixel(options_, q) - f.left_px).norm() <= sim::keypoint_support_px(f.size);
   }
 
   /// Keeps a new landmark's true point and scores its stereo match (new_from_wrong_matches).

@@ -176,13 +176,17 @@ inline Eigen::Vector2d left_pixel(const GlobeCameraOptions& o, const Eigen::Vect
   return {0.5 * o.image_width + o.stereo.focal_px * q.x() / q.z(), 0.5 * o.image_height + o.stereo.focal_px * q.y() / q.z()};
 }
 
+/// How far from a keypoint [px] a point still falls on the patch it describes: its radius (half its
+/// size), at least 2 px.
+inline double keypoint_support_px(double size) { return std::max(0.5 * size, 2.0); }
+
 /// The rendering's answer key for a stereo match seen from pose x: right when the surface behind its
 /// right keypoint, seen from the left camera, falls inside the left keypoint's support (its radius,
 /// at least 2 px), so both keypoints describe the same patch of the globe.
 inline bool stereo_match_is_right(const GlobeCameraOptions& o, const Vector12d& x, const Eigen::Vector2d& left_px,
                                   const Eigen::Vector2d& right_px, double left_size) {
   const auto seen_right = surface_point(o, x, right_px.x(), right_px.y(), StereoSide::right);
-  return seen_right && (left_pixel(o, in_left_camera(x, *seen_right)) - left_px).norm() <= std::max(0.5 * left_size, 2.0);
+  return seen_right && (left_pixel(o, in_left_camera(x, *seen_right)) - left_px).norm() <= keypoint_support_px(left_size);
 }
 
 }  // namespace sextant::sim
