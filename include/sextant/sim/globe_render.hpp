@@ -181,8 +181,8 @@ inline Eigen::Vector2d left_pixel(const GlobeCameraOptions& o, const Eigen::Vect
 inline double keypoint_support_px(double size) { return std::max(0.5 * size, 2.0); }
 
 /// The rendering's answer key for a stereo match seen from pose x: right when the surface behind its
-/// right keypoint, seen from the left camera, falls inside the left keypoint's support (its radius,
-/// at least 2 px), so both keypoints describe the same patch of the globe.
+/// right keypoint, seen from the left camera, falls inside the left keypoint's support
+/// (keypoint_support_px), so both keypoints describe the same patch of the globe.
 inline bool stereo_match_is_right(const GlobeCameraOptions& o, const Vector12d& x, const Eigen::Vector2d& left_px,
                                   const Eigen::Vector2d& right_px, double left_size) {
   const auto seen_right = surface_point(o, x, right_px.x(), right_px.y(), StereoSide::right);
