@@ -291,10 +291,13 @@ inline std::vector<ConfigKey> globe_keys() {
      [](RunnerConfig& c, const std::string& v) { c.globe.pool.max_new_per_step = parse_integer<std::size_t>(v, 1, 1e6); }},
     {"globe", "pool_eviction", "least_recently_seen",
      "which landmarks make room in a full pool: least_recently_seen (thesis) | fewest_sightings (seen in the fewest "
-     "steps first: tracked points stay for the loop)",
+     "steps first: tracked points stay for the loop) | fewest_sightings_without_fill (the same among those whose "
+     "removal links nothing new in SEIF's information, then least recently seen)",
      [](RunnerConfig& c, const std::string& v) {
        c.globe.pool.eviction = parse_choice<PoolEviction>(
-           v, {{"least_recently_seen", PoolEviction::least_recently_seen}, {"fewest_sightings", PoolEviction::fewest_sightings}});
+           v, {{"least_recently_seen", PoolEviction::least_recently_seen},
+               {"fewest_sightings", PoolEviction::fewest_sightings},
+               {"fewest_sightings_without_fill", PoolEviction::fewest_sightings_without_fill}});
      }},
     {"globe", "seif_active", "150 250 0", "SEIF runs, one per value: active landmarks (0 = all)",
      [](RunnerConfig& c, const std::string& v) { c.globe.seif_active = parse_active_counts(v, false); }},

@@ -77,6 +77,40 @@ TEST(LandmarkPoolPolicy, FewestSightingsEvictsTheLandmarkSeenInTheFewestStepsFir
   EXPECT_TRUE(policy.contains(10) && policy.contains(15));
 }
 
+/// A back-end that only says which removals would add links (as SeifSlam::removal_adds_no_links).
+struct BackendWithFill {
+  std::set<LandmarkId> with_fill, removed;
+  bool removal_adds_no_links(LandmarkId id) const { return !with_fill.contains(id); }
+  void remove_landmark(LandmarkId id) { removed.insert(id); }
+  UpdateResult update(std::span<const Obs>) { return {}; }
+};
+
+TEST(LandmarkPoolPolicy, FewestSightingsWithoutFillPassesOverARemovalThatWouldAddLinks) {
+  const PoolLimits limits{.max_landmarks = 4, .max_new_per_step = 4, .eviction = PoolEviction::fewest_sightings_without_fill};
+  LandmarkPoolPolicy policy(limits);
+  BackendWithFill backend{.with_fill = {10, 11}};
+  auto step = [&](std::initializer_list<LandmarkId> ids, std::size_t k) {
+    backend.removed.clear();
+    const auto observations = observe(ids);
+    update_through_pool(backend, policy, std::span<const Obs>(observations), k);
+    return backend.removed;
+  };
+  step({10}, 0);
+  step({10}, 1);
+  step({11}, 2);
+  step({12, 13}, 3);
+  // Fewest sightings: 11, 12, 13 (one step each), then 10 (two). 10 and 11 would add links, so 12
+  // and 13 go (fewest_sightings would take 11 and 12, the thesis's order 10 and 11).
+  EXPECT_EQ(step({14, 15}, 4), (std::set<LandmarkId>{12, 13}));
+  // Only 10 and 11 (both with fill) are left besides the landmarks seen now: the least recently
+  // seen goes, 10 (last seen at step 1), not 11, which fewest_sightings would take.
+  EXPECT_EQ(step({14, 15, 16}, 5), (std::set<LandmarkId>{10}));
+  EXPECT_EQ(step({20}, 6), (std::set<LandmarkId>{16}));  // 11 still passed over
+  // A plan without the back-end's answer treats every removal as adding none.
+  const auto observations = observe({21});
+  EXPECT_EQ(policy.plan(std::span<const Obs>(observations)).evict, (std::vector<LandmarkId>{11}));
+}
+
 TEST(LandmarkPoolPolicy, AdmitsNewLandmarksInTheGivenOrderUpToThePerStepLimit) {
   LandmarkPoolPolicy policy({.max_landmarks = 100, .max_new_per_step = 2});
   const auto observations = observe({5, 3, 9, 1});
@@ -98,7 +132,8 @@ TEST(LandmarkPoolPolicy, NeverExceedsCapacityOrThePerStepLimitOnARandomStream) {
   std::mt19937_64 rng(3);
   std::uniform_int_distribution<LandmarkId> id(0, 300);
   std::uniform_int_distribution<int> count(0, 40);
-  for (const PoolEviction eviction : {PoolEviction::least_recently_seen, PoolEviction::fewest_sightings}) {
+  for (const PoolEviction eviction :
+       {PoolEviction::least_recently_seen, PoolEviction::fewest_sightings, PoolEviction::fewest_sightings_without_fill}) {
     const PoolLimits limits{.max_landmarks = 60, .max_new_per_step = 7, .eviction = eviction};
     LandmarkPoolPolicy policy(limits);
     std::set<LandmarkId> pool;

@@ -111,6 +111,41 @@ TEST(SparseInformation, ARowOfBlocksIsLandmarkBlockForEachSlot) {
   for (std::size_t key = 0; key < 100; ++key) info.links(0).prefetch_entry(key);
 }
 
+/// Landmark-landmark links (each direction counted) and robot links of a form.
+std::pair<std::size_t, std::size_t> link_counts(const Info& info) {
+  std::size_t links = 0;
+  for (std::size_t i = 0; i < info.num_landmarks(); ++i) links += info.links(i).size();
+  return {links, info.robot_links().size()};
+}
+
+TEST(SparseInformation, SaysWhetherMarginalizingASlotAddsLinks) {
+  // Every slot of random forms, sparse and dense, some landmarks linked to the robot: the answer
+  // against the links a marginalization leaves (no fill: exactly the slot's own links gone).
+  std::mt19937 rng(5);
+  std::size_t without_fill = 0, with_fill = 0;
+  for (int form = 0; form < 40; ++form) {
+    Info info = random_form(form % 2 == 0 ? 6 : 9, rng);
+    if (form % 4 < 2)  // dense: most pairs linked, so that many slots have a clique around them
+      for (std::size_t i = 0; i < info.num_landmarks(); ++i)
+        for (std::size_t j = i + 1; j < info.num_landmarks(); ++j)
+          if (rng() % 4 != 0) info.add_to_link(i, j, Block::Identity() * 0.1);
+    for (std::size_t i = 0; i < info.num_landmarks(); ++i)
+      if (rng() % 3 != 0) info.add_to_robot_link(i, Info::CrossBlock::Constant(0.1));
+    for (std::size_t slot = 0; slot < info.num_landmarks(); ++slot) {
+      Info copy = info;
+      const auto [links, robot_links] = link_counts(copy);
+      const bool answer = copy.marginalizing_adds_no_links(slot);
+      const std::size_t own = 2 * copy.links(slot).size(), own_robot = copy.is_linked_to_robot(slot) ? 1 : 0;
+      copy.marginalize_landmark(slot);
+      const auto [after, robot_after] = link_counts(copy);
+      EXPECT_EQ(answer, after == links - own && robot_after == robot_links - own_robot) << "form " << form << ", slot " << slot;
+      (answer ? without_fill : with_fill) += 1;
+    }
+  }
+  EXPECT_GT(without_fill, 20u);
+  EXPECT_GT(with_fill, 20u);
+}
+
 TEST(SquareWorkspace, HandsOutViewsOfOneBufferAndCopiesEmpty) {
   SquareWorkspace workspace;
   auto small = workspace.view(10);

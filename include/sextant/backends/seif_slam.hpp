@@ -155,6 +155,9 @@ class SeifSlam {
   void add_landmark(const LandmarkEstimate<M>& known);
   /// Marginalizes a landmark out of the information form (thesis Appendix C).
   void remove_landmark(LandmarkId id);
+  /// Whether remove_landmark(id) would link no two landmarks (or the robot and a landmark) that are
+  /// not linked already: the pool's PoolEviction::fewest_sightings_without_fill asks it to keep Omega sparse.
+  bool removal_adds_no_links(LandmarkId id) const { return info_.marginalizing_adds_no_links(landmarks_.slot(id)); }
 
   /// Solves Omega delta = r exactly (sparse Cholesky) and moves the whole mean to it.
   void recover_mean_exactly();

@@ -7,6 +7,7 @@
 /// GraphSLAM: marginalization; FastSLAM: from every particle).
 
 #include <algorithm>
+#include <concepts>
 #include <cstddef>
 #include <map>
 #include <set>
@@ -32,6 +33,11 @@ enum class PoolEviction {
   /// id): a point tracked over many frames stays for when the camera comes back (a loop), while
   /// points seen once or twice, most of an image front-end's new ones, make the room.
   fewest_sightings,
+  /// As fewest_sightings, passing over a landmark whose removal would add links to the back-end's
+  /// information form (SEIF: its neighbours are not linked pair by pair; an exact marginalization
+  /// links them) while one that adds none is left; the rest, when needed, least recently seen first
+  /// (which keeps the fill in the band of recent links). A back-end without links adds none.
+  fewest_sightings_without_fill,
 };
 
 struct PoolLimits {
@@ -74,6 +80,12 @@ class LandmarkPoolPolicy {
   /// PoolLimits::eviction names, never one observed in this step.
   template <class Measurement>
   PoolPlan<Measurement> plan(std::span<const Observation<Measurement>> observations) const {
+    return plan(observations, [](LandmarkId) { return true; });
+  }
+  /// The same, with the back-end's answer to "would removing this landmark add no link?" for
+  /// PoolEviction::fewest_sightings_without_fill (the other orders do not ask it).
+  template <class Measurement, class AddsNoLinks>
+  PoolPlan<Measurement> plan(std::span<const Observation<Measurement>> observations, AddsNoLinks adds_no_links) const {
     require_valid_observations(observations);  // the back-ends' own check: finite, no id twice
     PoolPlan<Measurement> out;
     std::unordered_set<LandmarkId> seen_now;
@@ -94,8 +106,11 @@ class LandmarkPoolPolicy {
     out.added = admit;
     out.refused = fresh.size() - admit;
     const std::size_t over = size() + admit > limits_.max_landmarks ? size() + admit - limits_.max_landmarks : 0;
-    for (auto it = eviction_order_.begin(); out.evict.size() < over && it != eviction_order_.end(); ++it)
-      if (!seen_now.contains(std::get<2>(*it))) out.evict.push_back(std::get<2>(*it));
+    if (limits_.eviction == PoolEviction::fewest_sightings_without_fill)
+      out.evict = evictions_without_fill(over, seen_now, adds_no_links);
+    else
+      for (auto it = eviction_order_.begin(); out.evict.size() < over && it != eviction_order_.end(); ++it)
+        if (!seen_now.contains(std::get<2>(*it))) out.evict.push_back(std::get<2>(*it));
     return out;
   }
 
@@ -127,7 +142,28 @@ class LandmarkPoolPolicy {
   /// (steps seen, or 0 for the thesis's order; last seen; id): the first to make room first.
   using EvictionKey = std::tuple<std::size_t, std::size_t, LandmarkId>;
   EvictionKey eviction_key(LandmarkId id, const Sightings& s) const {
-    return {limits_.eviction == PoolEviction::fewest_sightings ? s.steps : 0, s.last, id};
+    return {limits_.eviction == PoolEviction::least_recently_seen ? 0 : s.steps, s.last, id};
+  }
+  /// PoolEviction::fewest_sightings_without_fill: `count` landmarks not seen now, those whose removal
+  /// adds no link in fewest-sightings order, then the others least recently seen first. The answers
+  /// are all asked before any removal: removing a vertex whose neighbours form a clique keeps every
+  /// other such vertex one, and the removals with fill come after all those without.
+  template <class AddsNoLinks>
+  std::vector<LandmarkId> evictions_without_fill(std::size_t count, const std::unordered_set<LandmarkId>& seen_now,
+                                                 AddsNoLinks& adds_no_links) const {
+    std::vector<LandmarkId> out;
+    std::vector<std::pair<std::size_t, LandmarkId>> with_fill;  // (last seen, id)
+    for (auto it = eviction_order_.begin(); out.size() < count && it != eviction_order_.end(); ++it) {
+      const LandmarkId id = std::get<2>(*it);
+      if (seen_now.contains(id)) continue;
+      if (adds_no_links(id))
+        out.push_back(id);
+      else
+        with_fill.emplace_back(std::get<1>(*it), id);
+    }
+    std::sort(with_fill.begin(), with_fill.end());
+    for (std::size_t k = 0; out.size() < count && k < with_fill.size(); ++k) out.push_back(with_fill[k].second);
+    return out;
   }
   void forget(LandmarkId id) {
     const auto it = sightings_.find(id);
@@ -155,7 +191,12 @@ class LandmarkPoolPolicy {
 template <class Backend, class Measurement>
 UpdateResult update_through_pool(Backend& backend, LandmarkPoolPolicy& policy,
                                  std::span<const Observation<Measurement>> observations, std::size_t step) {
-  auto plan = policy.plan(observations);
+  auto plan = [&] {
+    if constexpr (requires(const Backend& b, LandmarkId id) { { b.removal_adds_no_links(id) } -> std::convertible_to<bool>; })
+      return policy.plan(observations, [&](LandmarkId id) { return std::as_const(backend).removal_adds_no_links(id); });
+    else
+      return policy.plan(observations);
+  }();
   for (LandmarkId id : plan.evict) {
     backend.remove_landmark(id);
     policy.evicted(id);

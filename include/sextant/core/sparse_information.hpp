@@ -11,6 +11,7 @@
 #include <Eigen/SparseCore>
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <optional>
 #include <span>
 #include <string>
@@ -155,6 +156,9 @@ class SparseInformation {
   /// Omega_{j,-j}, r' = r_{-j} - Omega_{-j,j} Omega_jj^-1 r_j, touching only its neighbours; then the
   /// last slot moves into the freed one. Throws numerical_error (form unchanged) if Omega_jj is not PD.
   void marginalize_landmark(std::size_t slot);
+  /// Whether marginalize_landmark(slot) would add no link: its neighbours (the robot among them when
+  /// linked) are already linked pair by pair, a simplicial vertex of Omega's graph. O(d^2) look-ups.
+  bool marginalizing_adds_no_links(std::size_t slot) const;
 
   /// The full symmetric Omega as a sparse matrix, ordered (robot, slot 0, slot 1, ...).
   Eigen::SparseMatrix<double> to_sparse() const;
@@ -334,6 +338,19 @@ void SparseInformation<X, M>::marginalize_landmark(std::size_t slot) {
   links_.pop_back();
   saved_in_.pop_back();
   landmark_residual_.conservativeResize(landmark_residual_.size() - M);
+}
+
+template <int X, int M>
+bool SparseInformation<X, M>::marginalizing_adds_no_links(std::size_t slot) const {
+  const Links& around = links_[slot];
+  const bool robot_linked = is_linked_to_robot(slot);
+  for (auto a = around.begin(); a != around.end(); ++a) {
+    if (robot_linked && !is_linked_to_robot(a->first)) return false;
+    const Links& of_a = links_[a->first];
+    for (auto b = std::next(a); b != around.end(); ++b)
+      if (!of_a.contains(b->first)) return false;
+  }
+  return true;
 }
 
 /// Relabels slot `from` as `to` (which must be empty), fixing every link that points at it.
