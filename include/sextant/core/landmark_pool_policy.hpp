@@ -106,11 +106,8 @@ class LandmarkPoolPolicy {
     out.added = admit;
     out.refused = fresh.size() - admit;
     const std::size_t over = size() + admit > limits_.max_landmarks ? size() + admit - limits_.max_landmarks : 0;
-    if (limits_.eviction == PoolEviction::fewest_sightings_without_fill)
-      out.evict = evictions_without_fill(over, seen_now, adds_no_links);
-    else
-      for (auto it = eviction_order_.begin(); out.evict.size() < over && it != eviction_order_.end(); ++it)
-        if (!seen_now.contains(std::get<2>(*it))) out.evict.push_back(std::get<2>(*it));
+    const bool ask = limits_.eviction == PoolEviction::fewest_sightings_without_fill;
+    out.evict = evictions(over, seen_now, [&](LandmarkId id) { return !ask || adds_no_links(id); });
     return out;
   }
 
@@ -144,13 +141,13 @@ class LandmarkPoolPolicy {
   EvictionKey eviction_key(LandmarkId id, const Sightings& s) const {
     return {limits_.eviction == PoolEviction::least_recently_seen ? 0 : s.steps, s.last, id};
   }
-  /// PoolEviction::fewest_sightings_without_fill: `count` landmarks not seen now, those whose removal
-  /// adds no link in fewest-sightings order, then the others least recently seen first. The answers
+  /// `count` landmarks not seen now: in the eviction order those whose removal adds no link (every
+  /// one, for the orders that do not ask), then the others least recently seen first. The answers
   /// are all asked before any removal: removing a vertex whose neighbours form a clique keeps every
   /// other such vertex one, and the removals with fill come after all those without.
   template <class AddsNoLinks>
-  std::vector<LandmarkId> evictions_without_fill(std::size_t count, const std::unordered_set<LandmarkId>& seen_now,
-                                                 AddsNoLinks& adds_no_links) const {
+  std::vector<LandmarkId> evictions(std::size_t count, const std::unordered_set<LandmarkId>& seen_now,
+                                    AddsNoLinks adds_no_links) const {
     std::vector<LandmarkId> out;
     std::vector<std::pair<std::size_t, LandmarkId>> with_fill;  // (last seen, id)
     for (auto it = eviction_order_.begin(); out.size() < count && it != eviction_order_.end(); ++it) {
