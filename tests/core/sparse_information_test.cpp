@@ -112,7 +112,7 @@ TEST(SparseInformation, ARowOfBlocksIsLandmarkBlockForEachSlot) {
 }
 
 /// Landmark-landmark links (each direction counted) and robot links of a form.
-std::pair<std::size_t, std::size_t> link_counts(const Info& info) {
+std::pair<std::size_t, std::size_t> total_links(const Info& info) {
   std::size_t links = 0;
   for (std::size_t i = 0; i < info.num_landmarks(); ++i) links += info.links(i).size();
   return {links, info.robot_links().size()};
@@ -133,11 +133,11 @@ TEST(SparseInformation, SaysWhetherMarginalizingASlotAddsLinks) {
       if (rng() % 3 != 0) info.add_to_robot_link(i, Info::CrossBlock::Constant(0.1));
     for (std::size_t slot = 0; slot < info.num_landmarks(); ++slot) {
       Info copy = info;
-      const auto [links, robot_links] = link_counts(copy);
+      const auto [links, robot_links] = total_links(copy);
       const bool answer = copy.marginalizing_adds_no_links(slot);
       const std::size_t own = 2 * copy.links(slot).size(), own_robot = copy.is_linked_to_robot(slot) ? 1 : 0;
       copy.marginalize_landmark(slot);
-      const auto [after, robot_after] = link_counts(copy);
+      const auto [after, robot_after] = total_links(copy);
       EXPECT_EQ(answer, after == links - own && robot_after == robot_links - own_robot) << "form " << form << ", slot " << slot;
       (answer ? without_fill : with_fill) += 1;
     }
