@@ -69,6 +69,8 @@ struct GlobeSettings {
   bool disparity_support = false;  ///< globe-stereo, stereo:DIR: FrontEndOptions::disparity_support
   double new_landmark_density = 0.0;  ///< per m^3, globe-stereo, stereo:DIR: MapAssociationOptions::new_landmark_density
   double student_t_dof = 0.0;  ///< globe-stereo, stereo:DIR: MapAssociationOptions::student_t_dof
+  std::size_t returning_after = 0;  ///< globe-stereo, stereo:DIR: ReturningLandmarkOptions::after_frames
+  double returning_window = 0.05;   ///< globe-stereo, stereo:DIR: ReturningLandmarkOptions::window
   bool row_search = false;  ///< [globe] stereo_correspondence = row_search: no detection in the right image
   bool pipelined = true;    ///< globe-stereo, stereo:DIR: frame k+1's front-end during frame k's filter half
   int opencv_threads = 1;   ///< globe-stereo, stereo:DIR: cv::setNumThreads during the run (0: OpenCV's default)
@@ -345,6 +347,12 @@ inline std::vector<ConfigKey> globe_stereo_keys() {
      "from the one predicted by the plane fitted (robustly) to the disparities of the others within 40 px (the radius "
      "doubled up to 160 px while they are fewer than 6): a wrong match off the surface around it",
      [](RunnerConfig& c, const std::string& v) { c.globe.disparity_support = parse_bool(v); }},
+  };
+}
+
+/// [globe]: how the stereo tracker associates and how its pipeline runs (globe-stereo, stereo:DIR).
+inline std::vector<ConfigKey> globe_stereo_association_keys() {
+  return {
     {"globe", "new_landmark_density", "0",
      "globe-stereo, stereo:DIR: per m^3, how dense a new point is in view; a feature inside a landmark's gate that "
      "matches no descriptor becomes a new landmark when that landmark's predictive density there is below this "
@@ -354,6 +362,15 @@ inline std::vector<ConfigKey> globe_stereo_keys() {
      "globe-stereo, stereo:DIR: a re-observation's error as a Student-t of this many degrees of freedom: its noise "
      "scaled by sqrt((dof + NIS) / (dof + 3)) (0: Gaussian)",
      [](RunnerConfig& c, const std::string& v) { c.globe.student_t_dof = non_negative(parse_number(v), v); }},
+    {"globe", "returning_after", "0",
+     "globe-stereo, stereo:DIR: a landmark in view that its gate did not take and that was not seen for this many "
+     "frames is matched by descriptor among the features within returning_window of its prediction, and taken when one rigid motion puts at least 10 such "
+     "pairs inside their gates (the drift since a loop began; 0: off)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.returning_after = parse_integer<std::size_t>(v, 0); }},
+    {"globe", "returning_window", "0.05",
+     "globe-stereo, stereo:DIR: how far from its prediction a returning landmark's feature may lie, as a share of its "
+     "distance from the camera (the drift it allows)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.returning_window = positive(parse_number(v), v); }},
     {"globe", "stereo_correspondence", "detect_both",
      "globe-stereo, stereo:DIR: detect_both (AKAZE in both images, matched along the rows by descriptor) | "
      "row_search (AKAZE in the left image only, each keypoint found along its row in the right by correlation)",
@@ -716,10 +733,11 @@ inline const std::vector<ConfigKey>& config_keys() {
   static const std::vector<ConfigKey> keys = [] {
     std::vector<ConfigKey> all;
     for (const auto& section : {detail::ship_keys(), detail::globe_keys(), detail::globe_stereo_keys(),
-                                detail::globe_graph_keys(), detail::vislam_keys(), detail::rawlog_keys(),
-                                detail::mrclam_keys(), detail::association_keys(), detail::ekf_keys(),
-                                detail::seif_keys(), detail::graph_keys(), detail::pose_graph_keys(),
-                                detail::fastslam_keys(), detail::scene_keys()})
+                                detail::globe_stereo_association_keys(), detail::globe_graph_keys(),
+                                detail::vislam_keys(), detail::rawlog_keys(), detail::mrclam_keys(),
+                                detail::association_keys(), detail::ekf_keys(), detail::seif_keys(),
+                                detail::graph_keys(), detail::pose_graph_keys(), detail::fastslam_keys(),
+                                detail::scene_keys()})
       all.insert(all.end(), section.begin(), section.end());
     return all;
   }();

@@ -9,6 +9,7 @@
 #include <iterator>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <random>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -465,6 +466,92 @@ TEST(MapAssociation, OnlyALandmarkLikelierThanANewPointKeepsAnUnmatchedFeatureOu
     EXPECT_THROW((void)associate_to_map(frame, std::span<const PredictedLandmark>(none), appearance, next,
                                         {.new_landmark_density = bad}),
                  invalid_input_error);
+}
+
+/// A loop's returning landmarks, 2 mm per axis in their (conditional) gates, seen again after the
+/// camera drifted by 2 degrees and 3 cm: none inside its gate, so the gate alone makes every feature
+/// a new landmark. Twelve features lie where that one motion puts their landmarks (0.3 mm noise),
+/// four match a landmark's descriptor 2 cm from where the motion puts it (inside the window the
+/// descriptors are matched in, outside the gate), three match nothing. The returning step
+/// (its window 10% of the depth) takes the twelve and only them, keeps the gate's own association
+/// first and renumbers the new ones; landmarks seen too recently, fewer pairs than it asks for, or a
+/// window narrower than the drift, take nothing.
+TEST(MapAssociation, ReturningLandmarksAreTakenWhenOneRigidMotionPutsThemInTheirGates) {
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> across(-0.3, 0.3), depth(0.8, 1.2);
+  std::normal_distribution<double> noise(0.0, 3e-4);
+  auto random_descriptor = [&] {
+    cv::Mat d(1, 32, CV_8U);
+    for (int b = 0; b < 32; ++b) d.at<std::uint8_t>(0, b) = static_cast<std::uint8_t>(random() & 0xFF);
+    return d;
+  };
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(2.0 * std::acos(-1.0) / 180.0, Eigen::Vector3d(1, 2, 3).normalized())
+                                .toRotationMatrix();
+  const Eigen::Vector3d t(0.03, -0.02, 0.01);
+  const Eigen::Matrix3d S_inverse = Eigen::Matrix3d::Identity() / (2e-3 * 2e-3);
+  std::vector<PredictedLandmark> predicted;
+  LandmarkAppearance appearance;
+  StereoFrame frame;
+  std::vector<cv::Mat> rows;
+  auto add_feature = [&](const Eigen::Vector3d& point, const cv::Mat& descriptor) {
+    frame.features.push_back({Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(), 2.0f, 1.0f, point});
+    rows.push_back(descriptor);
+  };
+  const cv::Mat tracked = random_descriptor();  // landmark 50, seen in the last frame, inside its gate
+  predicted.push_back({50, {0.1, 0.1, 1.0}, S_inverse});
+  appearance.set(50, tracked);
+  add_feature({0.1, 0.1, 1.0}, tracked);
+  for (LandmarkId id = 0; id < 16; ++id) {
+    const Eigen::Vector3d a(across(random), across(random), depth(random));
+    const cv::Mat d = random_descriptor();
+    predicted.push_back({id, a, S_inverse});
+    appearance.set(id, d);
+    const Eigen::Vector3d moved = R * a + t + Eigen::Vector3d(noise(random), noise(random), noise(random));
+    const Eigen::Vector3d astray = 0.02 * Eigen::Vector3d(noise(random), noise(random), noise(random)).normalized();
+    add_feature(id < 12 ? moved : Eigen::Vector3d(moved + astray), d);  // the last four 2 cm off the motion
+  }
+  for (int k = 0; k < 3; ++k) add_feature({across(random), across(random), depth(random)}, random_descriptor());
+  cv::vconcat(rows, frame.descriptors);
+  const std::span<const PredictedLandmark> view(predicted);
+  const MapAssociationOptions options{.max_descriptor_distance = 10, .ratio = 0.8};
+
+  auto run = [&](std::size_t unseen, std::size_t min_inliers, LandmarkId& next, double window = 0.1) {
+    auto a = associate_to_map(frame, view, appearance, next, options);
+    EXPECT_EQ(a.associated, 1u);  // only landmark 50 by its gate
+    std::vector<std::size_t> frames_unseen(predicted.size(), unseen);
+    frames_unseen[0] = 1;
+    associate_returning(frame, view, frames_unseen, appearance, options, {.after_frames = 30, .window = window, .min_inliers = min_inliers},
+                        a, next);
+    return a;
+  };
+  LandmarkId next = 100;
+  const auto a = run(50, 10, next);
+  ASSERT_EQ(a.returned, 12u);
+  ASSERT_EQ(a.associated, 13u);
+  EXPECT_EQ(a.observations[0].landmark_id, 50u);
+  for (std::size_t k = 1; k < 13; ++k) {
+    EXPECT_LT(a.observations[k].landmark_id, 12u);  // the twelve the motion explains, never an outlier
+    EXPECT_EQ(a.feature[k], 1 + a.observations[k].landmark_id);
+    EXPECT_EQ(a.observations[k].z, frame.features[a.feature[k]].point);  // measured as the feature is
+  }
+  ASSERT_EQ(a.created, 7u);  // four wrong places and three unknown points, renumbered from 100
+  for (std::size_t k = 0; k < 7; ++k) EXPECT_EQ(a.observations[13 + k].landmark_id, 100 + k);
+  EXPECT_EQ(next, 107u);
+
+  LandmarkId recent_next = 100;
+  const auto recent = run(29, 10, recent_next);  // not away long enough: the gate's answer stands
+  EXPECT_EQ(recent.returned, 0u);
+  EXPECT_EQ(recent.created, 19u);
+  EXPECT_EQ(recent_next, 119u);
+  LandmarkId few_next = 100;
+  EXPECT_EQ(run(50, 13, few_next).returned, 0u);  // twelve explained, thirteen asked for
+  LandmarkId narrow_next = 100;
+  EXPECT_EQ(run(50, 10, narrow_next, 0.01).returned, 0u);  // the drift (3-6 cm at 1 m) beyond a 1% window
+
+  auto unchanged = associate_to_map(frame, view, appearance, next, options);
+  const std::vector<std::size_t> too_few_ages(3, 50);
+  EXPECT_THROW(associate_returning(frame, view, too_few_ages, appearance, options, {.after_frames = 30}, unchanged, next),
+               invalid_input_error);
 }
 
 TEST(MapAssociation, GateThenDescriptorOneFeaturePerLandmark) {

@@ -36,6 +36,7 @@ using Observations = std::vector<Observation<Eigen::Vector3d>>;
 /// Sums over the frames of a run: the front-end's figures and the time per stage.
 struct FrontEndTotals {
   std::size_t frames = 0, left_keypoints = 0, stereo_matches = 0, observations = 0, associated = 0, created = 0;
+  std::size_t returned = 0;  ///< of the associated: returning landmarks ([globe] returning_after)
   std::size_t below_min_disparity = 0, without_support = 0;
   double min_disparity = 0.0;  ///< px, the front-end's floor
   vision::TrackerTimes times;
@@ -49,6 +50,7 @@ struct FrontEndTotals {
     without_support += f.without_support;
     observations += f.observations.size();
     for (bool is_new : f.is_new) ++(is_new ? created : associated);
+    returned += f.returned;
     times.detect += f.times.detect;
     times.match += f.times.match;
     times.triangulate += f.times.triangulate;
@@ -63,6 +65,9 @@ void print_front_end(const FrontEndTotals& t, const vision::SequenceClock& clock
   std::printf("front-end over %zu frames: %.0f left keypoints, %.0f stereo matches, %.1f observations per frame "
               "(%.1f associated, %.1f proposed as new)",
               t.frames, t.left_keypoints / n, t.stereo_matches / n, t.observations / n, t.associated / n, t.created / n);
+  if (settings.returning_after > 0)
+    std::printf("; %zu associations in all of returning landmarks (unseen for %zu frames or more)", t.returned,
+                settings.returning_after);
   if (t.min_disparity > 0)
     std::printf("; %zu stereo matches in all dropped below the disparity floor (%.2f px, %g standard deviations)",
                 t.below_min_disparity, t.min_disparity, settings.min_disparity_sigmas);
@@ -165,6 +170,8 @@ vision::StereoTrackerOptions tracker_options(const RunnerConfig& c, const PointI
   o.association.max_observations = static_cast<std::size_t>(c.globe.features_per_frame);
   o.association.new_landmark_density = c.globe.new_landmark_density;
   o.association.student_t_dof = c.globe.student_t_dof;
+  o.returning.after_frames = c.globe.returning_after;
+  o.returning.window = c.globe.returning_window;
   o.front_end.detector.octave_layers = c.globe.octave_layers;
   o.front_end.detector.threshold = static_cast<float>(c.globe.detector_threshold);
   if (c.globe.row_search) o.front_end.correspondence = vision::StereoCorrespondence::row_search;

@@ -10,6 +10,7 @@
 #include <concepts>
 #include <cstddef>
 #include <map>
+#include <optional>
 #include <set>
 #include <span>
 #include <string>
@@ -72,6 +73,11 @@ class LandmarkPoolPolicy {
   const PoolLimits& limits() const { return limits_; }
   std::size_t size() const { return sightings_.size(); }
   bool contains(LandmarkId id) const { return sightings_.contains(id); }
+  /// The step a pool landmark was last seen at; none for a landmark not in the pool.
+  std::optional<std::size_t> last_seen(LandmarkId id) const {
+    const auto it = sightings_.find(id);
+    return it == sightings_.end() ? std::nullopt : std::optional(it->second.last);
+  }
   const std::vector<PoolStepRecord>& history() const { return history_; }
 
   /// Plans one step without changing the policy: observations of landmarks in the pool pass; new

@@ -106,6 +106,7 @@ struct FrameAssociation {
   std::vector<Observation<Eigen::Vector3d>> observations;  ///< associated first, then new; ready for update()
   std::vector<std::size_t> feature;                        ///< per observation: its index in the frame
   std::size_t associated = 0, created = 0;
+  std::size_t returned = 0;  ///< of the associated: returning landmarks (vision/returning_landmarks.hpp)
   std::size_t gated_unmatched = 0;  ///< features inside a gate whose descriptors matched no landmark
 };
 

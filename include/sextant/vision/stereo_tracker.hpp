@@ -19,6 +19,7 @@
 #include "sextant/core/landmark_pool_policy.hpp"
 #include "sextant/models/euler_camera_12d.hpp"
 #include "sextant/vision/map_association.hpp"
+#include "sextant/vision/returning_landmarks.hpp"
 #include "sextant/vision/stereo_front_end.hpp"
 
 namespace sextant::vision {
@@ -37,6 +38,8 @@ struct StereoTrackerOptions {
   /// whose exact joint marginal of every landmark in view costs a factorization of Omega a frame.
   GateCovariance gate_covariance = GateCovariance::conditional;
   PoolLimits pool{};
+  /// Landmarks the camera comes back to, verified by one rigid motion (off by default).
+  ReturningLandmarkOptions returning{};
 };
 
 /// Seconds per stage of one frame: the front-end's three, then association (with the back-end's
@@ -51,6 +54,7 @@ struct TrackedFrame {
   std::vector<StereoFeature> observed;                     ///< the feature behind each observation
   std::vector<bool> is_new;                                ///< per observation: it proposed a new landmark
   std::size_t left_keypoints = 0, right_keypoints = 0, stereo_matches = 0, predicted = 0, gated_unmatched = 0;
+  std::size_t returned = 0;  ///< of the observations: returning landmarks (StereoTrackerOptions::returning)
   std::size_t below_min_disparity = 0;  ///< stereo matches the front-end dropped (FrontEndOptions::min_disparity)
   std::size_t without_support = 0;      ///< and dropped for want of support (FrontEndOptions::disparity_support)
   UpdateResult update;
@@ -106,11 +110,15 @@ class StereoTracker {
     start = Clock::now();
     const auto predicted = predict_landmarks_in_view(backend_, sensor_, front_end_.rig(), width_, height_,
                                                      options_.gate_covariance);
-    const auto association = associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance_,
-                                              next_id_, options_.association);
+    auto association = associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance_, next_id_,
+                                        options_.association);
+    if (options_.returning.after_frames > 0)
+      associate_returning(frame, predicted, frames_unseen(predicted), appearance_, options_.association,
+                          options_.returning, association, next_id_);
     out.times.associate = seconds_since(start);
     out.predicted = predicted.size();
     out.gated_unmatched = association.gated_unmatched;
+    out.returned = association.returned;
     start = Clock::now();
     out.update = update_through_pool(backend_, policy_, std::span<const Observation<Eigen::Vector3d>>(association.observations),
                                      step_++);
@@ -129,6 +137,14 @@ class StereoTracker {
   const StereoFrontEnd& front_end() const { return front_end_; }
 
  private:
+  /// Per prediction, the frames since the pool last saw its landmark (this frame is step_).
+  std::vector<std::size_t> frames_unseen(std::span<const PredictedLandmark> predicted) const {
+    std::vector<std::size_t> out;
+    out.reserve(predicted.size());
+    for (const PredictedLandmark& p : predicted) out.push_back(step_ - policy_.last_seen(p.id).value_or(step_));
+    return out;
+  }
+
   /// The descriptor of every landmark added in this frame (and with `latest`, of every one seen);
   /// evicted ones forgotten.
   void remember_appearance(const StereoFrame& frame, const FrameAssociation& association) {
