@@ -552,6 +552,14 @@ TEST(MapAssociation, ReturningLandmarksAreTakenWhenOneRigidMotionPutsThemInTheir
   const std::vector<std::size_t> too_few_ages(3, 50);
   EXPECT_THROW(associate_returning(frame, view, too_few_ages, appearance, options, {.after_frames = 30}, unchanged, next),
                invalid_input_error);
+  const std::vector<std::size_t> ages(predicted.size(), 50);
+  const auto before = unchanged.observations.size();
+  for (const ReturningLandmarkOptions bad : {ReturningLandmarkOptions{.after_frames = 30, .window = 0.0},
+                                             ReturningLandmarkOptions{.after_frames = 30, .min_inliers = 2},
+                                             ReturningLandmarkOptions{.after_frames = 30, .ransac_iterations = 0}})
+    EXPECT_THROW(associate_returning(frame, view, ages, appearance, options, bad, unchanged, next), invalid_input_error);
+  EXPECT_EQ(unchanged.observations.size(), before);
+  EXPECT_EQ(unchanged.returned, 0u);
 }
 
 TEST(MapAssociation, GateThenDescriptorOneFeaturePerLandmark) {

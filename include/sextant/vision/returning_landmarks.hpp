@@ -23,6 +23,7 @@
 #include <optional>
 #include <random>
 #include <span>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -45,6 +46,15 @@ struct ReturningLandmarkOptions {
   std::size_t min_inliers = 10;
   int ransac_iterations = 200;
 };
+
+/// Throws invalid_input_error naming the first bad setting: a window that is not positive and
+/// finite, fewer than three pairs to fix a motion, no RANSAC iteration.
+inline void require_valid(const ReturningLandmarkOptions& r) {
+  if (!(r.window > 0.0) || !std::isfinite(r.window))
+    throw invalid_input_error("returning landmarks: window " + std::to_string(r.window) + " must be > 0 and finite");
+  if (r.min_inliers < 3) throw invalid_input_error("returning landmarks: min_inliers must be >= 3 (a rigid motion)");
+  if (r.ransac_iterations < 1) throw invalid_input_error("returning landmarks: ransac_iterations must be >= 1");
+}
 
 namespace detail {
 
@@ -184,7 +194,8 @@ inline std::size_t merge_returning(const StereoFrame& frame, std::span<const Pre
 /// landmarks one rigid motion verifies: `frames_unseen[j]` is how long predicted[j] was out of the
 /// map's sight. Their features leave the new landmarks they were proposed as (those keep their order
 /// and are renumbered from the first new id, next_id with them); the observation cap holds, new
-/// landmarks giving way first. Returns how many were added.
+/// landmarks giving way first. Returns how many were added. Bad options (require_valid) or ages that
+/// do not match the predictions throw invalid_input_error before `association` changes.
 inline std::size_t associate_returning(const StereoFrame& frame, std::span<const PredictedLandmark> predicted,
                                        std::span<const std::size_t> frames_unseen, const LandmarkAppearance& appearance,
                                        const MapAssociationOptions& o, const ReturningLandmarkOptions& r,
@@ -193,9 +204,7 @@ inline std::size_t associate_returning(const StereoFrame& frame, std::span<const
   if (frames_unseen.size() != predicted.size())
     throw invalid_input_error("returning landmarks: " + std::to_string(frames_unseen.size()) + " ages for " +
                               std::to_string(predicted.size()) + " predicted landmarks");
-  if (!(r.window > 0.0) || !std::isfinite(r.window))
-    throw invalid_input_error("returning landmarks: window " + std::to_string(r.window) + " must be > 0 and finite");
-  if (r.min_inliers < 3) throw invalid_input_error("returning landmarks: min_inliers must be >= 3 (a rigid motion)");
+  require_valid(r);
   std::vector<bool> feature_taken(frame.features.size(), false);
   std::vector<LandmarkId> taken_ids;
   for (std::size_t k = 0; k < association.associated; ++k) {

@@ -69,7 +69,9 @@ class StereoTracker {
 
   StereoTracker(Backend backend, Sensor sensor, StereoRig rig, int width, int height, StereoTrackerOptions options = {})
       : sensor_(sensor), backend_(std::move(backend)), policy_(options.pool), front_end_(rig, options.front_end),
-        width_(width), height_(height), options_(options) {}
+        width_(width), height_(height), options_(options) {
+    if (options.returning.after_frames > 0) require_valid(options.returning);  // before any frame, not in one
+  }
 
   /// One frame: features of the pair, motion update over dt, association, pool, measurement update
   /// (observe, then incorporate). Bad images (empty, not 8-bit, sizes that differ) throw
