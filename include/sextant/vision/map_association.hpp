@@ -25,6 +25,7 @@
 #include "sextant/core/observation.hpp"
 #include "sextant/core/pose_mean.hpp"
 #include "sextant/vision/stereo_front_end.hpp"
+#include "sextant/vision/stereo_matching.hpp"
 
 namespace sextant::vision {
 
@@ -228,7 +229,6 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
   gated.assign(frame.features.size(), false);
   std::vector<FeaturePair> best(frame.features.size(), FeaturePair{0, 0, std::numeric_limits<double>::infinity(), 0.0});
   std::vector<double> second(frame.features.size(), std::numeric_limits<double>::infinity());
-  const int norm = frame.descriptors.type() == CV_8U ? cv::NORM_HAMMING : cv::NORM_L2;
   std::vector<double> xs;  // a landmark's gate can only hold the features whose x lies within its reach
   xs.reserve(frame.features.size());
   for (const StereoFeature& f : frame.features) xs.push_back(f.point.x());
@@ -253,7 +253,7 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
       if (!(nis <= gate)) continue;
       gated[i] = gated[i] || nis <= blocking_nis;
       if (!descriptor) continue;
-      const double distance = cv::norm(frame.descriptors.row(static_cast<int>(i)), *descriptor, norm);
+      const double distance = descriptor_distance(frame.descriptors, static_cast<int>(i), *descriptor, 0);
       if (distance < best[i].distance) {
         second[i] = best[i].distance;
         best[i] = {i, j, distance, nis};

@@ -30,6 +30,7 @@
 #include "sextant/core/chi_square.hpp"
 #include "sextant/eval/alignment.hpp"
 #include "sextant/vision/map_association.hpp"
+#include "sextant/vision/stereo_matching.hpp"
 
 namespace sextant::vision {
 
@@ -73,7 +74,6 @@ inline std::vector<ReturningPair> returning_descriptor_pairs(const StereoFrame& 
                                                              std::span<const std::size_t> free_features,
                                                              const LandmarkAppearance& appearance,
                                                              const MapAssociationOptions& o, double window) {
-  const int norm = frame.descriptors.type() == CV_8U ? cv::NORM_HAMMING : cv::NORM_L2;
   std::vector<ReturningPair> pairs;
   for (const std::size_t j : returning) {
     const cv::Mat* descriptor = appearance.find(predicted[j].id);
@@ -83,7 +83,7 @@ inline std::vector<ReturningPair> returning_descriptor_pairs(const StereoFrame& 
     const double reach = window * predicted[j].z.norm();
     for (const std::size_t i : free_features) {
       if ((frame.features[i].point - predicted[j].z).squaredNorm() > reach * reach) continue;
-      const double distance = cv::norm(frame.descriptors.row(static_cast<int>(i)), *descriptor, norm);
+      const double distance = descriptor_distance(frame.descriptors, static_cast<int>(i), *descriptor, 0);
       if (distance < best) {
         second = best;
         best = distance;
