@@ -72,6 +72,7 @@ struct GlobeSettings {
   std::size_t returning_after = 0;  ///< globe-stereo, stereo:DIR: ReturningLandmarkOptions::after_frames
   double returning_window = 0.05;   ///< globe-stereo, stereo:DIR: ReturningLandmarkOptions::window
   bool row_search = false;  ///< [globe] stereo_correspondence = row_search: no detection in the right image
+  int right_refinement_px = 0;  ///< globe-stereo, stereo:DIR: FrontEndOptions::right_refinement.radius
   bool pipelined = true;    ///< globe-stereo, stereo:DIR: frame k+1's front-end during frame k's filter half
   int opencv_threads = 1;   ///< globe-stereo, stereo:DIR: cv::setNumThreads during the run (0: OpenCV's default)
 };
@@ -377,6 +378,10 @@ inline std::vector<ConfigKey> globe_stereo_association_keys() {
      [](RunnerConfig& c, const std::string& v) {
        c.globe.row_search = one_of(v, {"detect_both", "row_search"}, "stereo correspondence") == "row_search";
      }},
+    {"globe", "right_refinement", "0",
+     "globe-stereo, stereo:DIR: detect_both's right x taken from the left patch's correlation peak along the row "
+     "within this many px of the right keypoint (ZNCC >= 0.9, no second peak >= 0.9; else the keypoint's x); 0: off",
+     [](RunnerConfig& c, const std::string& v) { c.globe.right_refinement_px = parse_integer<int>(v, 0, 64); }},
     {"globe", "pipelined", "true",
      "globe-stereo, stereo:DIR: true (frame k+1's features found on a second thread while frame k is associated "
      "and filtered, as a live camera allows; the same results) | false (one frame after another)",

@@ -37,7 +37,7 @@ using Observations = std::vector<Observation<Eigen::Vector3d>>;
 struct FrontEndTotals {
   std::size_t frames = 0, left_keypoints = 0, stereo_matches = 0, observations = 0, associated = 0, created = 0;
   std::size_t returned = 0;  ///< of the associated: returning landmarks ([globe] returning_after)
-  std::size_t below_min_disparity = 0, without_support = 0;
+  std::size_t below_min_disparity = 0, without_support = 0, right_refined = 0;
   double min_disparity = 0.0;  ///< px, the front-end's floor
   vision::TrackerTimes times;
   double render = 0.0;
@@ -48,6 +48,7 @@ struct FrontEndTotals {
     stereo_matches += f.stereo_matches;
     below_min_disparity += f.below_min_disparity;
     without_support += f.without_support;
+    right_refined += f.right_refined;
     observations += f.observations.size();
     for (bool is_new : f.is_new) ++(is_new ? created : associated);
     returned += f.returned;
@@ -73,6 +74,9 @@ void print_front_end(const FrontEndTotals& t, const vision::SequenceClock& clock
                 t.below_min_disparity, t.min_disparity, settings.min_disparity_sigmas);
   if (settings.disparity_support)
     std::printf("; %zu dropped for want of support from their neighbours' disparities", t.without_support);
+  if (settings.right_refinement_px > 0)
+    std::printf("; %.1f right x a frame moved to the correlation peak within %d px", t.right_refined / n,
+                settings.right_refinement_px);
   if (truth)
     std::printf("; association precision %.4f (%zu of %zu right against the rendering)", truth->precision(),
                 truth->right(), truth->associated());
@@ -175,6 +179,7 @@ vision::StereoTrackerOptions tracker_options(const RunnerConfig& c, const PointI
   o.front_end.detector.octave_layers = c.globe.octave_layers;
   o.front_end.detector.threshold = static_cast<float>(c.globe.detector_threshold);
   if (c.globe.row_search) o.front_end.correspondence = vision::StereoCorrespondence::row_search;
+  o.front_end.right_refinement.radius = c.globe.right_refinement_px;
   o.gate_covariance = c.globe.tracker_exact_gate ? vision::GateCovariance::joint_marginal : vision::GateCovariance::conditional;
   return o;
 }

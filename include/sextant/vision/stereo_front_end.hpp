@@ -34,6 +34,7 @@ struct FrontEndOptions {
   bool parallel_detection = true;  ///< detect_both: left and right on two threads
   StereoCorrespondence correspondence = StereoCorrespondence::detect_both;
   RowSearchOptions row_search{};   ///< row_search's settings
+  RightRefinementOptions right_refinement{};  ///< detect_both: the right x by correlation (off by default)
   /// px: a match of smaller disparity is dropped before triangulation (significant_disparity gives
   /// the bound for a number of standard deviations). 0 keeps every match: a wrong match at a pixel of
   /// disparity on the rendered globe becomes a landmark 170 m deep that the sparse filters' mean
@@ -68,6 +69,7 @@ struct StereoFrame {
   std::size_t left_keypoints = 0, right_keypoints = 0;
   std::size_t below_min_disparity = 0;  ///< matches dropped by FrontEndOptions::min_disparity
   std::size_t without_support = 0;      ///< matches dropped by FrontEndOptions::disparity_support
+  std::size_t right_refined = 0;        ///< matches whose right x FrontEndOptions::right_refinement moved
   FrontEndTimes times;
 };
 
@@ -80,6 +82,7 @@ class StereoFrontEnd {
                                 " px must be finite and >= 0");
     if (options.slant_noise) require_valid(options.slant);
     if (options.disparity_support) require_valid(options.support);
+    require_valid(options.right_refinement);
   }
 
   const StereoRig& rig() const { return rig_; }
@@ -113,6 +116,7 @@ class StereoFrontEnd {
       out.right_keypoints = r.keypoints.size();
       lap(out.times.detect);
       matches = match_stereo(left_features, r, options_.matching);
+      out.right_refined = refine_right_by_correlation(left, right, matches, options_.right_refinement);
     }
     strongest_first(matches, left_features);
     lap(out.times.match);

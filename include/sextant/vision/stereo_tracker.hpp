@@ -57,6 +57,7 @@ struct TrackedFrame {
   std::size_t returned = 0;  ///< of the observations: returning landmarks (StereoTrackerOptions::returning)
   std::size_t below_min_disparity = 0;  ///< stereo matches the front-end dropped (FrontEndOptions::min_disparity)
   std::size_t without_support = 0;      ///< and dropped for want of support (FrontEndOptions::disparity_support)
+  std::size_t right_refined = 0;        ///< stereo matches whose right x moved (FrontEndOptions::right_refinement)
   UpdateResult update;
   TrackerTimes times;
 };
@@ -106,6 +107,7 @@ class StereoTracker {
     out.stereo_matches = frame.features.size();
     out.below_min_disparity = frame.below_min_disparity;
     out.without_support = frame.without_support;
+    out.right_refined = frame.right_refined;
     auto start = Clock::now();
     backend_.predict(control, dt);
     out.times.backend = seconds_since(start);
