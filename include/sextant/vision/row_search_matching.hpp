@@ -4,7 +4,8 @@
 /// along the same row, refined to a fraction of a pixel by a parabola through the peak (the search
 /// ORB-SLAM2's stereo refines its matches with; here it replaces the right image's detection, which
 /// costs as much as the left's). A match must correlate strongly, stand clear of any other peak
-/// on the row (repeated texture) and not lie where the search range is cut off.
+/// on the row (repeated texture) and not lie where the search range is cut off. The same search over
+/// a few pixels around a right keypoint refines a descriptor match's right x (refine_right_by_correlation).
 
 #include <Eigen/Core>
 #include <algorithm>
