@@ -227,8 +227,7 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
                                                          const MapAssociationOptions& o, std::vector<bool>& gated) {
   const double gate = chi_square_quantile(3, o.gate_probability);
   gated.assign(frame.features.size(), false);
-  std::vector<FeaturePair> best(frame.features.size(), FeaturePair{0, 0, std::numeric_limits<double>::infinity(), 0.0});
-  std::vector<double> second(frame.features.size(), std::numeric_limits<double>::infinity());
+  std::vector<NearestTwo<FeaturePair>> nearest(frame.features.size());
   std::vector<double> xs;  // a landmark's gate can only hold the features whose x lies within its reach
   xs.reserve(frame.features.size());
   for (const StereoFeature& f : frame.features) xs.push_back(f.point.x());
@@ -254,18 +253,12 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
       gated[i] = gated[i] || nis <= blocking_nis;
       if (!descriptor) continue;
       const double distance = descriptor_distance(frame.descriptors, static_cast<int>(i), *descriptor, 0);
-      if (distance < best[i].distance) {
-        second[i] = best[i].distance;
-        best[i] = {i, j, distance, nis};
-      } else if (distance < second[i]) {
-        second[i] = distance;
-      }
+      nearest[i].offer(distance, {i, j, distance, nis});
     }
   }
   std::vector<FeaturePair> pairs;
-  for (std::size_t i = 0; i < frame.features.size(); ++i)
-    if (best[i].distance <= o.max_descriptor_distance && (o.ratio >= 1.0 || best[i].distance < o.ratio * second[i]))
-      pairs.push_back(best[i]);
+  for (const auto& n : nearest)
+    if (n.best <= o.max_descriptor_distance && (o.ratio >= 1.0 || n.clearly_nearest(o.ratio))) pairs.push_back(n.nearest);
   return pairs;
 }
 

@@ -78,22 +78,13 @@ inline std::vector<ReturningPair> returning_descriptor_pairs(const StereoFrame& 
   for (const std::size_t j : returning) {
     const cv::Mat* descriptor = appearance.find(predicted[j].id);
     if (!descriptor) continue;
-    double best = std::numeric_limits<double>::infinity(), second = best;
-    std::size_t best_feature = 0;
+    NearestTwo<std::size_t> nearest;
     const double reach = window * predicted[j].z.norm();
-    for (const std::size_t i : free_features) {
-      if ((frame.features[i].point - predicted[j].z).squaredNorm() > reach * reach) continue;
-      const double distance = descriptor_distance(frame.descriptors, static_cast<int>(i), *descriptor, 0);
-      if (distance < best) {
-        second = best;
-        best = distance;
-        best_feature = i;
-      } else if (distance < second) {
-        second = distance;
-      }
-    }
-    if (best <= o.max_descriptor_distance && (o.ratio >= 1.0 || best < o.ratio * second))
-      pairs.push_back({j, best_feature, static_cast<int>(best)});
+    for (const std::size_t i : free_features)
+      if ((frame.features[i].point - predicted[j].z).squaredNorm() <= reach * reach)
+        nearest.offer(descriptor_distance(frame.descriptors, static_cast<int>(i), *descriptor, 0), i);
+    if (nearest.best <= o.max_descriptor_distance && (o.ratio >= 1.0 || nearest.clearly_nearest(o.ratio)))
+      pairs.push_back({j, nearest.nearest, static_cast<int>(nearest.best)});
   }
   std::stable_sort(pairs.begin(), pairs.end(), [](const auto& a, const auto& b) { return a.distance < b.distance; });
   std::vector<char> used(frame.features.size(), 0);

@@ -38,6 +38,26 @@ inline double descriptor_distance(const cv::Mat& a, int i, const cv::Mat& b, int
 
 inline Eigen::Vector2d pixel(const cv::KeyPoint& k) { return {k.pt.x, k.pt.y}; }
 
+/// The nearest and second-nearest descriptor distances among the candidates offered, with the
+/// nearest's payload: what Lowe's ratio test compares. A tie with the nearest counts as the second.
+template <class Payload>
+struct NearestTwo {
+  double best = std::numeric_limits<double>::infinity(), second = best;
+  Payload nearest{};
+  bool any() const { return best < std::numeric_limits<double>::infinity(); }
+  void offer(double distance, const Payload& candidate) {
+    if (distance < best) {
+      second = best;
+      best = distance;
+      nearest = candidate;
+    } else if (distance < second) {
+      second = distance;
+    }
+  }
+  /// best < ratio x second (an only candidate, second = inf, passes).
+  bool clearly_nearest(double ratio) const { return best < ratio * second; }
+};
+
 inline bool on_epipolar_segment(const Eigen::Vector2d& left, const Eigen::Vector2d& right, const StereoMatchOptions& o) {
   const double disparity = left.x() - right.x();
   return std::abs(left.y() - right.y()) <= o.max_row_difference && disparity > 0.0 && disparity <= o.max_disparity;
@@ -77,24 +97,16 @@ inline SortedIndex row_index(const Features& f) {
 /// For feature i of `from`, the best candidate of `to` that passes the ratio test, or -1.
 inline int best_partner(const Features& from, int i, const Features& to, const SortedIndex& to_rows,
                         const StereoMatchOptions& o, bool from_is_left, double& best_distance) {
-  double best = std::numeric_limits<double>::infinity(), second = best;
-  int best_j = -1;
+  NearestTwo<int> candidates{.nearest = -1};
   const Eigen::Vector2d p = pixel(from.keypoints[static_cast<std::size_t>(i)]);
   for (const int j : to_rows.band(p.y(), o.max_row_difference)) {
     const Eigen::Vector2d q = pixel(to.keypoints[static_cast<std::size_t>(j)]);
     if (!(from_is_left ? on_epipolar_segment(p, q, o) : on_epipolar_segment(q, p, o))) continue;
-    const double d = descriptor_distance(from.descriptors, i, to.descriptors, j);
-    if (d < best) {
-      second = best;
-      best = d;
-      best_j = j;
-    } else if (d < second) {
-      second = d;
-    }
+    candidates.offer(descriptor_distance(from.descriptors, i, to.descriptors, j), j);
   }
-  if (best_j < 0 || !(best < o.ratio * second)) return -1;  // an only candidate has second = inf and passes
-  best_distance = best;
-  return best_j;
+  if (candidates.nearest < 0 || !candidates.clearly_nearest(o.ratio)) return -1;
+  best_distance = candidates.best;
+  return candidates.nearest;
 }
 
 }  // namespace detail
