@@ -184,6 +184,11 @@ TEST(StereoFrontEnd, RightRefinementByCorrelationMakesTheDisparityMoreAccurate) 
   EXPECT_LT(median(refined_error), median(keypoint_error));
   EXPECT_LT(beyond_a_pixel(refined_error), beyond_a_pixel(keypoint_error));
   const RenderedPair pair;
+  const cv::Mat left_image = as_mat(pair.images.left), colour(left_image.size(), CV_8UC3, cv::Scalar::all(0));
+  std::vector<StereoMatch> one = {{0, 0, Eigen::Vector2d(100, 100), Eigen::Vector2d(90, 100), 0.0}};
+  EXPECT_THROW(refine_right_by_correlation(left_image, colour, one, refinement), invalid_input_error);
+  EXPECT_THROW(search_rows(left_image, colour, Features{}), invalid_input_error);
+  EXPECT_EQ(one[0].right_px, Eigen::Vector2d(90, 100));
   for (const int radius : {-1, 65})
     EXPECT_THROW(StereoFrontEnd(pair.rig, {.right_refinement = {.radius = radius}}), invalid_input_error) << radius;
 }

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -44,6 +45,12 @@ inline double parabola_offset(float before, float at, float after) {
 struct RowPeak {
   double x = std::nan(""), correlation = 0.0;  ///< x NaN: no match
 };
+
+/// Throws invalid_input_error, naming `what`, unless both images are 8-bit grey and of one size.
+inline void require_grey_pair(const cv::Mat& left, const cv::Mat& right, const char* what) {
+  if (left.type() != CV_8UC1 || right.type() != CV_8UC1 || left.size() != right.size())
+    throw invalid_input_error(std::string(what) + ": the images must be 8-bit grayscale of one size");
+}
 
 /// The right image prepared once per frame for many row searches: its grey levels as floats and the
 /// integral images of the levels and their squares (each window's mean and variance in O(1)).
@@ -151,8 +158,7 @@ inline void require_valid(const RightRefinementOptions& o) {
 inline std::size_t refine_right_by_correlation(const cv::Mat& left, const cv::Mat& right, std::vector<StereoMatch>& matches,
                                                const RightRefinementOptions& o) {
   if (o.radius == 0 || matches.empty()) return 0;
-  if (left.type() != CV_8UC1 || right.type() != CV_8UC1 || left.size() != right.size())
-    throw invalid_input_error("stereo right refinement: the images must be 8-bit grayscale of one size");
+  detail::require_grey_pair(left, right, "stereo right refinement");
   const detail::RightImage prepared(right);
   std::vector<double> x(matches.size(), std::nan(""));
   cv::parallel_for_(cv::Range(0, static_cast<int>(matches.size())), [&](const cv::Range& range) {
@@ -177,8 +183,7 @@ inline std::size_t refine_right_by_correlation(const cv::Mat& left, const cv::Ma
 /// keypoint) and `distance` is 1 - ZNCC.
 inline std::vector<StereoMatch> search_rows(const cv::Mat& left, const cv::Mat& right, const Features& left_features,
                                             const RowSearchOptions& o = {}) {
-  if (left.type() != CV_8UC1 || right.type() != CV_8UC1 || left.size() != right.size())
-    throw invalid_input_error("stereo row search: the images must be 8-bit grayscale of one size");
+  detail::require_grey_pair(left, right, "stereo row search");
   const detail::RightImage prepared(right);
   std::vector<detail::RowPeak> peaks(left_features.keypoints.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(peaks.size())), [&](const cv::Range& range) {

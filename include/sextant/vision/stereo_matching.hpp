@@ -44,7 +44,6 @@ template <class Payload>
 struct NearestTwo {
   double best = std::numeric_limits<double>::infinity(), second = best;
   Payload nearest{};
-  bool any() const { return best < std::numeric_limits<double>::infinity(); }
   void offer(double distance, const Payload& candidate) {
     if (distance < best) {
       second = best;
