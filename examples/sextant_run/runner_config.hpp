@@ -73,6 +73,7 @@ struct GlobeSettings {
   double returning_window = 0.05;   ///< globe-stereo, stereo:DIR: ReturningLandmarkOptions::window
   bool row_search = false;  ///< [globe] stereo_correspondence = row_search: no detection in the right image
   int right_refinement_px = 0;  ///< globe-stereo, stereo:DIR: FrontEndOptions::right_refinement.radius
+  std::uint64_t texture_seed = 1;  ///< globe-stereo: sim::GlobeRenderOptions::texture_seed (the globe's pattern)
   bool pipelined = true;    ///< globe-stereo, stereo:DIR: frame k+1's front-end during frame k's filter half
   int opencv_threads = 1;   ///< globe-stereo, stereo:DIR: cv::setNumThreads during the run (0: OpenCV's default)
 };
@@ -278,6 +279,10 @@ inline std::vector<ConfigKey> globe_keys() {
   return {
     {"globe", "seed", "1", "simulation seed of the globe (12D camera) experiment",
      [](RunnerConfig& c, const std::string& v) { c.globe.seed = parse_integer<std::uint64_t>(v, 0); }},
+    {"globe", "texture_seed", "1",
+     "globe-stereo: seed of the globe's procedural texture (another value renders another pattern on the same "
+     "orbit: a world the front-end's settings were not chosen on)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.texture_seed = parse_integer<std::uint64_t>(v, 0); }},
     {"globe", "steps", "500", "steps (thesis: 500); the circle closes near step 420",
      [](RunnerConfig& c, const std::string& v) { c.globe.steps = parse_integer<int>(v, 1, 1e6); }},
     {"globe", "points", "3000", "feature points on the globe",

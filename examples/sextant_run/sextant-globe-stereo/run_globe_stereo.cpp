@@ -251,9 +251,10 @@ std::vector<TableRow> run_globe_stereo(const CliOptions& cli, const std::string&
   const std::string& save_images = cli.save_images;
   const auto o = globe_options(config.globe);
   const auto points = sim::simulate_globe_camera(o);
-  std::printf("\n== globe-stereo: the globe of --dataset globe rendered as %dx%d stereo pairs (seed %llu), %d frames "
-              "through the AKAZE front-end; pool Mmax = %zu, max_new = %zu, %d observations per frame at most\n",
-              o.image_width, o.image_height, static_cast<unsigned long long>(o.seed), o.num_steps,
+  std::printf("\n== globe-stereo: the globe of --dataset globe rendered as %dx%d stereo pairs (seed %llu, texture seed %llu), "
+              "%d frames through the AKAZE front-end; pool Mmax = %zu, max_new = %zu, %d observations per frame at most\n",
+              o.image_width, o.image_height, static_cast<unsigned long long>(o.seed),
+              static_cast<unsigned long long>(config.globe.texture_seed), o.num_steps,
               config.globe.pool.max_landmarks, config.globe.pool.max_new_per_step, config.globe.features_per_frame);
   const auto calibration = calibration_of(o, points.prior);
   if (!save_images.empty()) vision::write_calibration(save_images, calibration);
@@ -271,7 +272,7 @@ std::vector<TableRow> run_globe_stereo(const CliOptions& cli, const std::string&
     ProgressBar progress("globe-stereo: render + front-end", points.steps.size());
     auto render = [&](std::size_t k) {
       const auto start = std::chrono::steady_clock::now();
-      const auto images = sim::render_stereo(o, points.true_poses[k + 1]);
+      const auto images = sim::render_stereo(o, points.true_poses[k + 1], {.texture_seed = config.globe.texture_seed});
       totals.render += seconds_since(start);
       vision::StereoPair pair{vision::as_mat(images.left).clone(), vision::as_mat(images.right).clone()};
       if (!save_images.empty()) vision::write_stereo_pair(save_images, k, pair.left, pair.right);
