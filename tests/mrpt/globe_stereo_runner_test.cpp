@@ -77,6 +77,25 @@ TEST_F(GlobeStereoRunner, AnEseifTrackerTracksAndOneWithoutAnActiveCountIsRefuse
   EXPECT_NE(refused.err.find("eseif_active"), std::string::npos) << refused.err;
 }
 
+/// `[globe] texture_seed` reaches the renderer: the same orbit's first pair comes out another pattern,
+/// and the header names the seed.
+TEST_F(GlobeStereoRunner, AnotherTextureSeedRendersAnotherPattern) {
+  auto first_left = [&](const std::string& texture_seed) {
+    const auto ini = dir / ("texture" + texture_seed + ".ini");
+    std::ofstream(ini) << "[globe]\nsteps = 1\ntexture_seed = " << texture_seed << "\n";
+    const auto images = dir / ("images" + texture_seed);
+    const auto r = run_program(std::string(SEXTANT_GLOBE_STEREO_EXE) + " -d globe-stereo -b ekf -c " + ini.string() +
+                                   " --save-images " + images.string(),
+                               dir);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("texture seed " + texture_seed), std::string::npos) << r.out;
+    return slurp(images / "left" / "000000.png");
+  };
+  const std::string one = first_left("1"), two = first_left("2");
+  EXPECT_FALSE(one.empty());
+  EXPECT_TRUE(one != two) << "texture seeds 1 and 2 rendered the same first left image";
+}
+
 TEST_F(GlobeStereoRunner, ABadSequenceStopsWithOneLineNamingTheFile) {
   fs::create_directories(dir / "empty" / "left");
   fs::create_directories(dir / "empty" / "right");
