@@ -93,6 +93,7 @@ TEST_F(GlobeStereoRunner, AnotherTextureSeedRendersAnotherPattern) {
   };
   const std::string one = first_left("1"), two = first_left("2");
   EXPECT_FALSE(one.empty());
+  EXPECT_FALSE(two.empty());
   EXPECT_TRUE(one != two) << "texture seeds 1 and 2 rendered the same first left image";
 }
 
