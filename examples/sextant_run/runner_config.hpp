@@ -73,6 +73,9 @@ struct GlobeSettings {
   double returning_window = 0.05;   ///< globe-stereo, stereo:DIR: ReturningLandmarkOptions::window
   bool row_search = false;  ///< [globe] stereo_correspondence = row_search: no detection in the right image
   int right_refinement_px = 0;  ///< globe-stereo, stereo:DIR: FrontEndOptions::right_refinement.radius
+  bool slanted_correlation = false;  ///< globe-stereo, stereo:DIR: FrontEndOptions::slanted_correlation
+  bool drop_unmeasured_disparities = false;  ///< globe-stereo, stereo:DIR: SlantedCorrelationOptions::drop_unmeasured
+  double disparity_sigma = 0.0;  ///< px, globe-stereo, stereo:DIR: StereoPointNoise::disparity_sigma of the image observations
   std::uint64_t texture_seed = 1;  ///< globe-stereo: sim::GlobeRenderOptions::texture_seed (the globe's pattern)
   bool pipelined = true;    ///< globe-stereo, stereo:DIR: frame k+1's front-end during frame k's filter half
   int opencv_threads = 1;   ///< globe-stereo, stereo:DIR: cv::setNumThreads during the run (0: OpenCV's default)
@@ -387,6 +390,21 @@ inline std::vector<ConfigKey> globe_stereo_association_keys() {
      "globe-stereo, stereo:DIR: detect_both's right x taken from the left patch's correlation peak along the row "
      "within this many px of the right keypoint (ZNCC >= 0.9, no second peak >= 0.9; else the keypoint's x); 0: off",
      [](RunnerConfig& c, const std::string& v) { c.globe.right_refinement_px = parse_integer<int>(v, 0, 64); }},
+    {"globe", "slanted_correlation", "false",
+     "globe-stereo, stereo:DIR: each match's disparity re-measured within 4 px of its own by correlating the left "
+     "patch with the right image warped by the disparity its neighbours' quadratic fit gives across the patch "
+     "(ZNCC >= 0.9; else it keeps its own, or is dropped with unmeasured_disparities = drop)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.slanted_correlation = parse_bool(v); }},
+    {"globe", "unmeasured_disparities", "keep",
+     "globe-stereo, stereo:DIR, with slanted_correlation: keep (a match whose disparity the correlation does not "
+     "measure keeps its own) | drop",
+     [](RunnerConfig& c, const std::string& v) {
+       c.globe.drop_unmeasured_disparities = one_of(v, {"keep", "drop"}, "unmeasured disparities") == "drop";
+     }},
+    {"globe", "disparity_sigma", "0",
+     "globe-stereo, stereo:DIR: px, the image observations' disparity noise, independent of the left keypoint's "
+     "(a disparity measured at the keypoint, slanted_correlation); 0: the right keypoint's own noise",
+     [](RunnerConfig& c, const std::string& v) { c.globe.disparity_sigma = non_negative(parse_number(v), v); }},
     {"globe", "pipelined", "true",
      "globe-stereo, stereo:DIR: true (frame k+1's features found on a second thread while frame k is associated "
      "and filtered, as a live camera allows; the same results) | false (one frame after another)",

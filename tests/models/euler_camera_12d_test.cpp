@@ -161,6 +161,21 @@ TEST(StereoPointNoise, IsTheFirstOrderPropagationOfPixelNoiseThroughTriangulatio
   // Depth std sqrt(2) z^2 sigma / (f b).
   EXPECT_NEAR(std::sqrt(noise.covariance(q)(2, 2)),
               std::sqrt(2.0) * q.z() * q.z() * noise.pixel_sigma / (noise.focal_px * noise.baseline), 1e-12);
+  // A disparity measured with its own noise: the same propagation from (u_left, v_left, d), whose
+  // errors are independent, and the depth std z^2 sigma_d / (f b).
+  StereoPointNoise measured = noise;
+  measured.disparity_sigma = 0.1;
+  auto from_disparity = [&](const Eigen::Vector3d& uvd) { return triangulate(Eigen::Vector3d(uvd(0), uvd(1), uvd(0) - uvd(2))); };
+  const Eigen::Vector3d uvd(pixels(0), pixels(1), pixels(0) - pixels(2));
+  Eigen::Matrix3d B;
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Vector3d h = Eigen::Vector3d::Zero();
+    h(i) = 1e-4;
+    B.col(i) = (from_disparity(uvd + h) - from_disparity(uvd - h)) / 2e-4;
+  }
+  const Eigen::Vector3d variances(noise.pixel_sigma * noise.pixel_sigma, noise.pixel_sigma * noise.pixel_sigma, 0.01);
+  EXPECT_TRUE(measured.covariance(q).isApprox(B * variances.asDiagonal() * B.transpose(), 1e-6));
+  EXPECT_NEAR(std::sqrt(measured.covariance(q)(2, 2)), q.z() * q.z() * 0.1 / (noise.focal_px * noise.baseline), 1e-12);
 }
 
 TEST(PointInCamera3D, MeasuresThePointInTheCameraFrameAndInvertsIt) {

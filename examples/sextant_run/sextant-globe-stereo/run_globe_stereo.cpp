@@ -37,7 +37,7 @@ using Observations = std::vector<Observation<Eigen::Vector3d>>;
 struct FrontEndTotals {
   std::size_t frames = 0, left_keypoints = 0, stereo_matches = 0, observations = 0, associated = 0, created = 0;
   std::size_t returned = 0;  ///< of the associated: returning landmarks ([globe] returning_after)
-  std::size_t below_min_disparity = 0, without_support = 0, right_refined = 0;
+  std::size_t below_min_disparity = 0, without_support = 0, right_refined = 0, slant_refined = 0, slant_unmeasured = 0;
   double min_disparity = 0.0;  ///< px, the front-end's floor
   vision::TrackerTimes times;
   double render = 0.0;
@@ -49,6 +49,8 @@ struct FrontEndTotals {
     below_min_disparity += f.below_min_disparity;
     without_support += f.without_support;
     right_refined += f.right_refined;
+    slant_refined += f.slant_refined;
+    slant_unmeasured += f.slant_unmeasured;
     observations += f.observations.size();
     for (bool is_new : f.is_new) ++(is_new ? created : associated);
     returned += f.returned;
@@ -77,6 +79,9 @@ void print_front_end(const FrontEndTotals& t, const vision::SequenceClock& clock
   if (settings.right_refinement_px > 0)
     std::printf("; %.1f right x a frame moved to the correlation peak within %d px", t.right_refined / n,
                 settings.right_refinement_px);
+  if (settings.slanted_correlation)
+    std::printf("; %.1f disparities a frame measured along the slant (%zu unmeasured matches dropped in all)",
+                t.slant_refined / n, t.slant_unmeasured);
   if (truth)
     std::printf("; association precision %.4f (%zu of %zu right against the rendering)", truth->precision(),
                 truth->right(), truth->associated());
@@ -180,6 +185,8 @@ vision::StereoTrackerOptions tracker_options(const RunnerConfig& c, const PointI
   o.front_end.detector.threshold = static_cast<float>(c.globe.detector_threshold);
   if (c.globe.row_search) o.front_end.correspondence = vision::StereoCorrespondence::row_search;
   o.front_end.right_refinement.radius = c.globe.right_refinement_px;
+  o.front_end.slanted_correlation = c.globe.slanted_correlation;
+  o.front_end.slanted.drop_unmeasured = c.globe.drop_unmeasured_disparities;
   o.gate_covariance = c.globe.tracker_exact_gate ? vision::GateCovariance::joint_marginal : vision::GateCovariance::conditional;
   return o;
 }
@@ -258,12 +265,15 @@ std::vector<TableRow> run_globe_stereo(const CliOptions& cli, const std::string&
               config.globe.pool.max_landmarks, config.globe.pool.max_new_per_step, config.globe.features_per_frame);
   const auto calibration = calibration_of(o, points.prior);
   if (!save_images.empty()) vision::write_calibration(save_images, calibration);
-  return with_tracker(config, points.motion, points.sensor, points.prior, calibration.rig(), o.image_width, o.image_height,
+  PointInCamera3D image_sensor = points.sensor;  // the observations' noise as the front-end measures them
+  image_sensor.noise.disparity_sigma = config.globe.disparity_sigma;
+  return with_tracker(config, points.motion, image_sensor, points.prior, calibration.rig(), o.image_width, o.image_height,
                       [&](auto& tracker, const std::string& tracker_name) {
     eval::GlobeAssociationTruth truth(o);
     FrontEndTotals totals;
     totals.min_disparity = tracker.front_end().options().min_disparity;
     sim::GlobeCameraDataset stereo = points;
+    stereo.sensor = image_sensor;
     std::vector<Observations> frames;
     std::vector<std::vector<bool>> is_new;
     std::vector<Vector12d> tracked_means;
@@ -321,6 +331,7 @@ std::vector<TableRow> run_stereo_directory(const CliOptions& cli, const std::str
   PointInCamera3D sensor;
   sensor.noise.focal_px = c.K(0, 0);
   sensor.noise.baseline = c.baseline;
+  sensor.noise.disparity_sigma = config.globe.disparity_sigma;
   const auto prior = vision::initial_camera_estimate(c);
   return with_tracker(config, EulerCamera12D{}, sensor, prior, c.rig(), c.width, c.height,
                       [&](auto& tracker, const std::string& tracker_name) {

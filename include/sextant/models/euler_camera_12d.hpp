@@ -212,12 +212,17 @@ struct EulerCamera12D {
 /// optical axis): pixel noise sigma in u_left, v_left and u_right, focal length f [px], baseline b.
 /// With d = u_left - u_right = f b / z, the point is (u - c_x, v - c_y, f) b / d; its covariance to
 /// first order is Q = A Sigma_(u, v, d) A^T with A = (z / f) [1 0 -x/b; 0 1 -y/b; 0 0 -z/b]:
-/// lateral std z sigma / f, depth std sqrt(2) z^2 sigma / (f b).
+/// lateral std z sigma / f, depth std sqrt(2) z^2 sigma / (f b). A disparity measured at the left
+/// keypoint (vision/slanted_correlation.hpp) has its own noise sigma_d, independent of the keypoint's:
+/// Sigma_(u, v, d) = diag(sigma^2, sigma^2, sigma_d^2), depth std z^2 sigma_d / (f b).
 struct StereoPointNoise {
   double focal_px = 600.0;
   double baseline = 0.1;     ///< m
   double pixel_sigma = 0.5;  ///< px
   double min_depth = 0.05;   ///< m: Q of a point nearer than this (or behind) is Q at this depth
+  /// px: sigma_d of a disparity measured at the left keypoint; 0: u_right detected with u_left's
+  /// noise (d's variance 2 sigma^2, its error correlated with u_left's)
+  double disparity_sigma = 0.0;
 
   Eigen::Matrix3d covariance(const Eigen::Vector3d& q) const {
     const double z = std::max(q.z(), min_depth), x = q.x(), y = q.y();
@@ -226,7 +231,10 @@ struct StereoPointNoise {
     A *= z / focal_px;
     const double s2 = pixel_sigma * pixel_sigma;
     Eigen::Matrix3d pixel;  // covariance of (u_left, v_left, d = u_left - u_right)
-    pixel << s2, 0, s2, 0, s2, 0, s2, 0, 2 * s2;
+    if (disparity_sigma > 0.0)
+      pixel << s2, 0, 0, 0, s2, 0, 0, 0, disparity_sigma * disparity_sigma;
+    else
+      pixel << s2, 0, s2, 0, s2, 0, s2, 0, 2 * s2;
     const Eigen::Matrix3d Q = A * pixel * A.transpose();
     return 0.5 * (Q + Q.transpose());
   }

@@ -18,6 +18,7 @@
 #include "sextant/vision/features.hpp"
 #include "sextant/vision/row_search_matching.hpp"
 #include "sextant/vision/slant_noise.hpp"
+#include "sextant/vision/slanted_correlation.hpp"
 #include "sextant/vision/stereo_matching.hpp"
 #include "sextant/vision/stereo_triangulation.hpp"
 
@@ -35,6 +36,10 @@ struct FrontEndOptions {
   StereoCorrespondence correspondence = StereoCorrespondence::detect_both;
   RowSearchOptions row_search{};   ///< row_search's settings
   RightRefinementOptions right_refinement{};  ///< detect_both: the right x by correlation (off by default)
+  /// Each match's disparity by correlation along its neighbours' disparity plane (vision/slanted_correlation.hpp),
+  /// after right_refinement: the right image's stretch on a slanted surface no longer shortens it.
+  bool slanted_correlation = false;
+  SlantedCorrelationOptions slanted{};
   /// px: a match of smaller disparity is dropped before triangulation (significant_disparity gives
   /// the bound for a number of standard deviations). 0 keeps every match: a wrong match at a pixel of
   /// disparity on the rendered globe becomes a landmark 170 m deep that the sparse filters' mean
@@ -70,6 +75,8 @@ struct StereoFrame {
   std::size_t below_min_disparity = 0;  ///< matches dropped by FrontEndOptions::min_disparity
   std::size_t without_support = 0;      ///< matches dropped by FrontEndOptions::disparity_support
   std::size_t right_refined = 0;        ///< matches whose right x FrontEndOptions::right_refinement moved
+  std::size_t slant_refined = 0;        ///< matches whose disparity FrontEndOptions::slanted_correlation measured
+  std::size_t slant_unmeasured = 0;     ///< and matches it dropped, unmeasured (SlantedCorrelationOptions::drop_unmeasured)
   FrontEndTimes times;
 };
 
@@ -83,6 +90,7 @@ class StereoFrontEnd {
     if (options.slant_noise) require_valid(options.slant);
     if (options.disparity_support) require_valid(options.support);
     require_valid(options.right_refinement);
+    if (options.slanted_correlation) require_valid(options.slanted);
   }
 
   const StereoRig& rig() const { return rig_; }
@@ -117,6 +125,11 @@ class StereoFrontEnd {
       lap(out.times.detect);
       matches = match_stereo(left_features, r, options_.matching);
       out.right_refined = refine_right_by_correlation(left, right, matches, options_.right_refinement);
+    }
+    if (options_.slanted_correlation) {
+      const auto refined = refine_right_along_slant(left, right, matches, options_.slanted);
+      out.slant_refined = refined.measured;
+      out.slant_unmeasured = refined.dropped;
     }
     strongest_first(matches, left_features);
     lap(out.times.match);

@@ -58,6 +58,8 @@ struct TrackedFrame {
   std::size_t below_min_disparity = 0;  ///< stereo matches the front-end dropped (FrontEndOptions::min_disparity)
   std::size_t without_support = 0;      ///< and dropped for want of support (FrontEndOptions::disparity_support)
   std::size_t right_refined = 0;        ///< stereo matches whose right x moved (FrontEndOptions::right_refinement)
+  std::size_t slant_refined = 0;        ///< stereo matches whose disparity FrontEndOptions::slanted_correlation measured
+  std::size_t slant_unmeasured = 0;     ///< and those it dropped, unmeasured
   UpdateResult update;
   TrackerTimes times;
 };
@@ -108,6 +110,8 @@ class StereoTracker {
     out.below_min_disparity = frame.below_min_disparity;
     out.without_support = frame.without_support;
     out.right_refined = frame.right_refined;
+    out.slant_refined = frame.slant_refined;
+    out.slant_unmeasured = frame.slant_unmeasured;
     auto start = Clock::now();
     backend_.predict(control, dt);
     out.times.backend = seconds_since(start);
