@@ -203,7 +203,7 @@ TEST(StereoFrontEnd, RightRefinementByCorrelationMakesTheDisparityMoreAccurate) 
 /// and its curvature across the patch moving their peaks; with the curvature the mean error there is
 /// smaller than every peer's, and the RMS error of the warped correlations smaller than the
 /// unwarped ones'. No left pixel or row moves, no disparity moves beyond the search and a grid step,
-/// and bad options or images are refused with the matches left as they were.
+/// and bad options, images or pixels are refused with the matches left as they were.
 TEST(StereoFrontEnd, SlantedCorrelationMeasuresTheDisparityOfObliqueSurfacesWithoutBias) {
   const sim::GlobeCameraOptions options;
   const auto orbit = sim::simulate_globe_camera(options).true_poses;
@@ -271,6 +271,10 @@ TEST(StereoFrontEnd, SlantedCorrelationMeasuresTheDisparityOfObliqueSurfacesWith
   std::vector<StereoMatch> one = {{0, 0, Eigen::Vector2d(100, 100), Eigen::Vector2d(90, 100), 0.0}};
   EXPECT_THROW(refine_right_along_slant(left_image, colour, one, slanted), invalid_input_error);
   EXPECT_EQ(one[0].right_px, Eigen::Vector2d(90, 100));
+  std::vector<StereoMatch> two = {one[0], {1, 1, Eigen::Vector2d(std::nan(""), 120), Eigen::Vector2d(110, 120), 0.0}};
+  EXPECT_THROW(refine_right_along_slant(left_image, left_image, two, slanted), invalid_input_error);
+  EXPECT_EQ(two[0].right_px, Eigen::Vector2d(90, 100));
+  EXPECT_EQ(two.size(), 2u);
   for (const SlantedCorrelationOptions& bad : {SlantedCorrelationOptions{.search_px = 0.0}, SlantedCorrelationOptions{.step_px = 5.0},
                                               SlantedCorrelationOptions{.half_window = 0},
                                               SlantedCorrelationOptions{.min_correlation = std::nan("")},
