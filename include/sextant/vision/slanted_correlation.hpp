@@ -2,8 +2,8 @@
 /// \file A stereo match's disparity by correlation along the surface's slant. On a slanted surface
 /// the right image is the left one stretched along the rows: the disparity of a plane is affine in
 /// the left pixel, d(p) = d0 + g . (p - p0) (disparity_support.hpp), and on the rendered globe g
-/// reaches 0.3 px/px at a 45 degree slant and 0.5 at 60 (f b / z ~ 0.3 at the orbit's distance, times
-/// the slant's tangent). A square window correlated unwarped, or a keypoint detected in each image,
+/// reaches 0.3 px/px at a 45 degree slant and 0.5 at 60 (|g| = b / z = d / f, ~0.3 at the orbit's
+/// distance, times the slant's tangent). A square window correlated unwarped, or a keypoint detected in each image,
 /// then measures the disparity short where the surface turns away (by 0.09-0.14 px beyond 45 degrees
 /// on the rendered globe), and so does a warp by the plane, by the curvature of the disparity across
 /// the patch. Here the left patch around the keypoint is compared with the right image sampled

@@ -36,8 +36,9 @@ struct FrontEndOptions {
   StereoCorrespondence correspondence = StereoCorrespondence::detect_both;
   RowSearchOptions row_search{};   ///< row_search's settings
   RightRefinementOptions right_refinement{};  ///< detect_both: the right x by correlation (off by default)
-  /// Each match's disparity by correlation along its neighbours' disparity plane (vision/slanted_correlation.hpp),
-  /// after right_refinement: the right image's stretch on a slanted surface no longer shortens it.
+  /// Each match's disparity by correlation along the surface's slant (vision/slanted_correlation.hpp: the
+  /// right image warped by the disparity's second-order shape, fitted to the match's neighbours), after
+  /// right_refinement: the right image's stretch on a slanted surface no longer shortens it.
   bool slanted_correlation = false;
   SlantedCorrelationOptions slanted{};
   /// px: a match of smaller disparity is dropped before triangulation (significant_disparity gives
