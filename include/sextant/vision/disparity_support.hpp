@@ -118,18 +118,26 @@ inline double neighbourhood(const PixelNeighbours& neighbours, std::size_t i, co
   }
 }
 
-/// The second, robust fit: the neighbours within `sigmas` robust deviations (1.4826 x the median
-/// absolute residual, at least min_sigma_px) of the first fit; nothing when too few are left.
+/// The members whose first-fit residuals lie within `sigmas` robust deviations (1.4826 x the median
+/// absolute residual, at least min_sigma_px): those a robust second fit keeps.
+inline std::vector<int> robust_inliers(std::span<const int> members, const std::vector<double>& residuals,
+                                       const DisparitySupportOptions& o) {
+  const double scale = std::max(o.min_sigma_px, 1.4826 * median_of_absolute(residuals));
+  std::vector<int> inliers;
+  for (std::size_t n = 0; n < members.size(); ++n)
+    if (std::abs(residuals[n]) <= o.sigmas * scale) inliers.push_back(members[n]);
+  return inliers;
+}
+
+/// The second, robust fit: the plane of the neighbours robust_inliers keeps from the first fit;
+/// nothing when too few are left.
 inline std::optional<LocalPlane> robust_plane(const LocalPlaneFit& fitter, std::size_t i, std::span<const int> others,
                                               const DisparitySupportOptions& o) {
   const auto first = fitter.fit(i, others);
   if (!first) return std::nullopt;
   std::vector<double> residuals;
   for (const int k : others) residuals.push_back(fitter.residual(*first, i, static_cast<std::size_t>(k)));
-  const double scale = std::max(o.min_sigma_px, 1.4826 * median_of_absolute(residuals));
-  std::vector<int> inliers;
-  for (std::size_t n = 0; n < others.size(); ++n)
-    if (std::abs(residuals[n]) <= o.sigmas * scale) inliers.push_back(others[n]);
+  const auto inliers = robust_inliers(others, residuals, o);
   if (static_cast<int>(inliers.size()) < o.min_neighbours) return std::nullopt;
   return fitter.fit(i, inliers);
 }

@@ -113,7 +113,7 @@ inline DisparityShape shape_from(const Eigen::Matrix<double, 6, 1>& c, double ra
 }
 
 /// The shape of match i's neighbourhood: the quadratic (or plane) of its neighbours (the match left
-/// out), refitted without those beyond o.sigmas robust deviations of the first fit; zero where too few.
+/// out), refitted to those robust_inliers keeps from the first fit (as robust_plane); zero where too few.
 inline DisparityShape disparity_shape(std::span<const Eigen::Vector2d> pixels, std::span<const double> disparities,
                                       std::size_t i, std::span<const int> others, double radius, const DisparitySupportOptions& o,
                                       bool curvature) {
@@ -125,10 +125,7 @@ inline DisparityShape disparity_shape(std::span<const Eigen::Vector2d> pixels, s
     const Eigen::Vector2d q = (pixels[static_cast<std::size_t>(k)] - pixels[i]) / radius;
     residuals.push_back(disparities[static_cast<std::size_t>(k)] - (*first)(0) - scaled.at(q));
   }
-  const double scale = std::max(o.min_sigma_px, 1.4826 * median_of_absolute(residuals));
-  std::vector<int> inliers;
-  for (std::size_t n = 0; n < others.size(); ++n)
-    if (std::abs(residuals[n]) <= o.sigmas * scale) inliers.push_back(others[n]);
+  const auto inliers = robust_inliers(others, residuals, o);
   if (static_cast<int>(inliers.size()) < o.min_neighbours) return {};
   const auto second = fit_disparity(pixels, disparities, i, inliers, radius, curvature);
   return second ? shape_from(*second, radius) : DisparityShape{};
