@@ -146,6 +146,15 @@ TEST_F(RunnerCli, GlobeRunsEveryBackEndThroughThePoolAndWritesBookkeepingAndScen
   }
   EXPECT_EQ(steps, (std::vector<double>{10, 20, 30, 40, 50, 60}));
   EXPECT_NE(r.out.find("GraphSLAM NEES: smoothed marginals"), std::string::npos) << r.out;
+  // The start's draw, which every step's NEES carries: under the isotropic 1 mm prior (the globe's
+  // default) its NEES is (distance / 1 mm)^2, to the printed digits.
+  const auto start = r.out.find("The start: the prior's position is ");
+  ASSERT_NE(start, std::string::npos) << r.out;
+  double mm = -1.0, start_nees = -1.0;
+  ASSERT_EQ(std::sscanf(r.out.c_str() + start, "The start: the prior's position is %lf mm off the true first pose, NEES %lf", &mm,
+                        &start_nees), 2) << r.out.substr(start, 200);
+  EXPECT_GT(mm, 0.0);
+  EXPECT_NEAR(start_nees, mm * mm, 0.01 * mm + 0.006) << "printed to two decimals each";
 }
 
 TEST_F(RunnerCli, GlobeRunsAloneInItsOwnProgram) {
