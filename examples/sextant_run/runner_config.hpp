@@ -64,6 +64,8 @@ struct GlobeSettings {
   bool tracker_exact_gate = false;
   int octave_layers = 4;            ///< globe-stereo, stereo:DIR: AKAZE's sublevels per octave (vision::DetectorOptions)
   double detector_threshold = 0.001;  ///< globe-stereo, stereo:DIR: AKAZE's response threshold
+  bool orb = false;                 ///< [globe] detector = orb: ORB instead of AKAZE (vision::Detector)
+  int orb_levels = 8;               ///< globe-stereo, stereo:DIR: ORB's pyramid levels (vision::DetectorOptions)
   double min_disparity_sigmas = 0.0;  ///< globe-stereo, stereo:DIR: stereo matches within this many std of zero disparity dropped
   bool slant_noise = false;  ///< globe-stereo, stereo:DIR: FrontEndOptions::slant_noise
   bool disparity_support = false;  ///< globe-stereo, stereo:DIR: FrontEndOptions::disparity_support
@@ -342,6 +344,14 @@ inline std::vector<ConfigKey> globe_stereo_keys() {
      [](RunnerConfig& c, const std::string& v) { c.globe.octave_layers = parse_integer<int>(v, 1, 16); }},
     {"globe", "detector_threshold", "0.001", "globe-stereo, stereo:DIR: AKAZE's response threshold (OpenCV's default)",
      [](RunnerConfig& c, const std::string& v) { c.globe.detector_threshold = positive(parse_number(v), v); }},
+    {"globe", "detector", "akaze",
+     "globe-stereo, stereo:DIR: akaze (nonlinear scale space, 486-bit MLDB descriptors) | orb (FAST corners, "
+     "256-bit steered BRIEF: a tenth of AKAZE's time; the association's descriptor distance follows the detector)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.orb = one_of(v, {"akaze", "orb"}, "detector") == "orb"; }},
+    {"globe", "orb_levels", "8",
+     "globe-stereo, stereo:DIR: ORB's pyramid levels, each 1.2 times coarser (OpenCV's default 8; 1: every corner "
+     "at full resolution, no scale invariance)",
+     [](RunnerConfig& c, const std::string& v) { c.globe.orb_levels = parse_integer<int>(v, 1, 16); }},
     {"globe", "min_disparity_sigmas", "0",
      "globe-stereo, stereo:DIR: stereo matches whose disparity is within this many of its standard deviations "
      "(sqrt(2) x the sensor's pixel noise) of zero are dropped, as points that cannot be told from one at infinity "

@@ -1,6 +1,6 @@
 // sextant-globe-stereo's runs (issue 12): the globe rendered as a rectified stereo sequence
 // (--dataset globe-stereo) or a user's rectified stereo sequence (--dataset stereo:<dir>), through the
-// OpenCV front-end (AKAZE, row matching, triangulation, association gated by the EKF's prediction,
+// OpenCV front-end (AKAZE or ORB, row matching, triangulation, association gated by the EKF's prediction,
 // the landmark pool) and then every back-end on the observations it produced.
 #include <chrono>
 #include <cstdio>
@@ -183,6 +183,9 @@ vision::StereoTrackerOptions tracker_options(const RunnerConfig& c, const PointI
   o.returning.window = c.globe.returning_window;
   o.front_end.detector.octave_layers = c.globe.octave_layers;
   o.front_end.detector.threshold = static_cast<float>(c.globe.detector_threshold);
+  if (c.globe.orb) o.front_end.detector.detector = vision::Detector::orb;
+  o.front_end.detector.orb_levels = c.globe.orb_levels;
+  o.association.max_descriptor_distance = vision::default_max_descriptor_distance(o.front_end.detector.detector);
   if (c.globe.row_search) o.front_end.correspondence = vision::StereoCorrespondence::row_search;
   o.front_end.right_refinement.radius = c.globe.right_refinement_px;
   o.front_end.slanted_correlation = c.globe.slanted_correlation;
@@ -259,10 +262,10 @@ std::vector<TableRow> run_globe_stereo(const CliOptions& cli, const std::string&
   const auto o = globe_options(config.globe);
   const auto points = sim::simulate_globe_camera(o);
   std::printf("\n== globe-stereo: the globe of --dataset globe rendered as %dx%d stereo pairs (seed %llu, texture seed %llu), "
-              "%d frames through the AKAZE front-end; pool Mmax = %zu, max_new = %zu, %d observations per frame at most\n",
+              "%d frames through the %s front-end; pool Mmax = %zu, max_new = %zu, %d observations per frame at most\n",
               o.image_width, o.image_height, static_cast<unsigned long long>(o.seed),
               static_cast<unsigned long long>(config.globe.texture_seed), o.num_steps,
-              config.globe.pool.max_landmarks, config.globe.pool.max_new_per_step, config.globe.features_per_frame);
+              config.globe.orb ? "ORB" : "AKAZE", config.globe.pool.max_landmarks, config.globe.pool.max_new_per_step, config.globe.features_per_frame);
   const auto calibration = calibration_of(o, points.prior);
   if (!save_images.empty()) vision::write_calibration(save_images, calibration);
   PointInCamera3D image_sensor = points.sensor;  // the observations' noise as the front-end measures them
