@@ -265,7 +265,8 @@ std::vector<TableRow> run_globe_stereo(const CliOptions& cli, const std::string&
               "%d frames through the %s front-end; pool Mmax = %zu, max_new = %zu, %d observations per frame at most\n",
               o.image_width, o.image_height, static_cast<unsigned long long>(o.seed),
               static_cast<unsigned long long>(config.globe.texture_seed), o.num_steps,
-              config.globe.orb ? "ORB" : "AKAZE", config.globe.pool.max_landmarks, config.globe.pool.max_new_per_step, config.globe.features_per_frame);
+              config.globe.orb ? "ORB" : "AKAZE", config.globe.pool.max_landmarks, config.globe.pool.max_new_per_step,
+              config.globe.features_per_frame);
   const auto calibration = calibration_of(o, points.prior);
   if (!save_images.empty()) vision::write_calibration(save_images, calibration);
   PointInCamera3D image_sensor = points.sensor;  // the observations' noise as the front-end measures them

@@ -18,8 +18,9 @@ struct Features {
 };
 
 /// ORB (Rublee et al., ICCV 2011: FAST corners ranked by Harris score, steered BRIEF, 256 bits) costs
-/// a tenth of AKAZE's time on the rendered globe (6 against 62 ms a 640 x 480 image on one core of the
-/// 2026-12-03 host) at integer-pixel corners: docs/results/real_time.md, "ORB".
+/// a tenth of AKAZE's time on the rendered globe at 8 pyramid levels, a 27th at one (5.9 and 2.6 ms a
+/// 640 x 480 image on one core against 62-75 for AKAZE's 2 layers, benchmarks/front_end_benchmark.cpp),
+/// at integer-pixel corners: docs/results/real_time.md, "ORB: the detector a frame can afford".
 enum class Detector { kaze, akaze, orb };
 
 /// AKAZE by default: on the rendered globe it finds as many features as KAZE, its stereo matches are

@@ -47,6 +47,7 @@ struct MapAssociationOptions {
   /// patches differ in about half), L2 for KAZE's unit-length float descriptors (set it near 0.3).
   /// On the rendered globe (300 frames, docs/results/globe_stereo.md) 60 with the ratio test at 0.8
   /// gave 99.99% right associations and EKF position MAE 3.5 mm; 90 without the test 99.96%, 5.3 mm.
+  /// Another detector's value: vision::default_max_descriptor_distance (vision/features.hpp).
   double max_descriptor_distance = 60.0;
   /// A feature's nearest landmark descriptor among those in whose gate it lies must be nearer than
   /// ratio x the second nearest (Lowe's test); 1 turns the test off.
