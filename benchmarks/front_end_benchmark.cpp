@@ -11,6 +11,7 @@
 #include "sextant/sim/globe_render.hpp"
 #include "sextant/vision/features.hpp"
 #include "sextant/vision/gray_image_view.hpp"
+#include "sextant/vision/opencv_threads.hpp"
 #include "sextant/vision/stereo_front_end.hpp"
 
 namespace {
@@ -37,19 +38,16 @@ vision::DetectorOptions detector_of(const benchmark::State& state) {
 
 /// One image (or pair) an iteration, taking the ten in turn: the time column is per image (pair).
 void BM_DetectOneImage(benchmark::State& state) {
-  const int threads = cv::getNumThreads();
-  cv::setNumThreads(1);
+  const vision::OpenCvThreads one_thread(1);
   const auto& pairs = rendered_pairs();
   auto detector = vision::make_detector(detector_of(state));
   std::size_t keypoints = 0, k = 0;
   for (auto _ : state) keypoints += vision::detect(vision::as_mat(pairs[k++ % pairs.size()].left), *detector).keypoints.size();
-  cv::setNumThreads(threads);
   state.counters["keypoints_per_image"] = static_cast<double>(keypoints) / static_cast<double>(k);
 }
 
 void BM_StereoFrontEnd(benchmark::State& state) {
-  const int threads = cv::getNumThreads();
-  cv::setNumThreads(1);
+  const vision::OpenCvThreads one_thread(1);
   const auto& pairs = rendered_pairs();
   const sim::GlobeCameraOptions o;
   const vision::StereoRig rig{o.stereo.focal_px, 0.5 * o.image_width, 0.5 * o.image_height, o.stereo.baseline};
@@ -61,7 +59,6 @@ void BM_StereoFrontEnd(benchmark::State& state) {
     const auto& pair = pairs[k++ % pairs.size()];
     features += front_end.process(vision::as_mat(pair.left), vision::as_mat(pair.right)).features.size();
   }
-  cv::setNumThreads(threads);
   state.counters["stereo_features_per_pair"] = static_cast<double>(features) / static_cast<double>(k);
 }
 

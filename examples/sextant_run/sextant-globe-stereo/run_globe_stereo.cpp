@@ -15,6 +15,7 @@
 #include <sextant/sim/globe_render.hpp>
 #include <sextant/eval/globe_association_truth.hpp>
 #include <sextant/vision/gray_image_view.hpp>
+#include <sextant/vision/opencv_threads.hpp>
 #include <sextant/vision/stereo_sequence.hpp>
 #include <sextant/vision/stereo_sequence_tracking.hpp>
 #include <sextant/vision/stereo_tracker.hpp>
@@ -218,25 +219,11 @@ auto with_tracker(const RunnerConfig& c, const EulerCamera12D& motion, const Poi
   return run(tracker, std::string("EKF"));
 }
 
-/// OpenCV's worker threads set for a run's duration and restored after it; 0 leaves OpenCV's setting.
-class OpenCvThreads {
- public:
-  explicit OpenCvThreads(int threads) : previous_(cv::getNumThreads()) {
-    if (threads > 0) cv::setNumThreads(threads);
-  }
-  ~OpenCvThreads() { cv::setNumThreads(previous_); }
-  OpenCvThreads(const OpenCvThreads&) = delete;
-  OpenCvThreads& operator=(const OpenCvThreads&) = delete;
-
- private:
-  int previous_;
-};
-
 /// The sequence through the tracker as [globe] pipelined and opencv_threads say (vision::track_sequence).
 template <class Tracker, class PairOf, class DtOf, class OnFrame>
 vision::SequenceClock track_frames(Tracker& tracker, std::size_t n, PairOf&& pair_of, DtOf&& dt_of, OnFrame&& on_frame,
                                    const RunnerConfig& config) {
-  const OpenCvThreads threads(config.globe.opencv_threads);
+  const vision::OpenCvThreads threads(config.globe.opencv_threads);
   return vision::track_sequence(tracker, n, pair_of, dt_of, on_frame, config.globe.pipelined);
 }
 
