@@ -1,7 +1,11 @@
 #include "sextant/core/dense_slot_map.hpp"
 
+#include "sextant/core/huge_page_arena.hpp"
+#include "sextant/core/link_rows.hpp"
+
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <map>
 #include <random>
 
@@ -15,11 +19,10 @@ std::map<std::size_t, double> contents(const DenseSlotMap<double>& map) {
   return out;
 }
 
-TEST(DenseSlotMap, BehavesAsAMapUnderRandomInsertsErasesAndRekeys) {
-  // Keys from a small range so that erases hit, probe runs collide and wrap around the table, and
-  // the table grows several times; every operation is checked against std::map.
+/// Keys from a small range so that erases hit, probe runs collide and wrap around the table, and
+/// the table grows several times; every operation is checked against std::map.
+void check_against_std_map(DenseSlotMap<double>& map) {
   std::mt19937 rng(7);
-  DenseSlotMap<double> map;
   std::map<std::size_t, double> reference;
   std::uniform_int_distribution<std::size_t> key(0, 300);
   std::uniform_int_distribution<int> operation(0, 9);
@@ -59,6 +62,69 @@ TEST(DenseSlotMap, BehavesAsAMapUnderRandomInsertsErasesAndRekeys) {
   EXPECT_TRUE(map.empty());
   EXPECT_FALSE(map.contains(0));
   EXPECT_TRUE(map.try_emplace(0, 1.0).second);
+}
+
+TEST(DenseSlotMap, BehavesAsAMapUnderRandomInsertsErasesAndRekeys) {
+  DenseSlotMap<double> map;
+  check_against_std_map(map);
+}
+
+TEST(DenseSlotMap, BehavesAsAMapInAnArenaAndCopiesOutOfIt) {
+  HugePageArena arena;
+  DenseSlotMap<double> map(&arena);
+  check_against_std_map(map);
+  EXPECT_GT(arena.bytes_carved(), 0u);
+  map.try_emplace(5, 2.0);
+  const DenseSlotMap<double> heap_copy = map;  // the default resource, as any std::pmr container's
+  HugePageArena other;
+  const DenseSlotMap<double> arena_copy(map, &other);
+  map.clear();
+  map.try_emplace(6, 3.0);
+  for (const DenseSlotMap<double>* copy : {&heap_copy, &arena_copy}) {
+    EXPECT_EQ(copy->size(), 2u);
+    EXPECT_EQ(copy->find(5)->second, 2.0);
+    EXPECT_FALSE(copy->contains(6));
+  }
+}
+
+TEST(HugePageArena, ReusesAFreedBlockForTheNextRequestOfItsSize) {
+  HugePageArena arena;
+  void* a = arena.allocate(80 * 1024, 8);
+  void* b = arena.allocate(80 * 1024, 8);
+  EXPECT_NE(a, b);
+  EXPECT_EQ(arena.bytes_carved(), 2u * 80 * 1024);
+  arena.deallocate(a, 80 * 1024, 8);
+  void* small = arena.allocate(40, 8);  // another size: carved, not the freed block
+  EXPECT_NE(small, a);
+  EXPECT_EQ(arena.allocate(80 * 1024, 8), a);
+  EXPECT_EQ(arena.bytes_carved(), 2u * 80 * 1024 + 48);  // 40 rounded up to 16
+  void* wide = arena.allocate(64, 256);  // alignment beyond max_align_t: from the default heap
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(wide) % 256, 0u);
+  arena.deallocate(wide, 64, 256);
+  void* large = arena.allocate(std::size_t{100} << 20, 16);  // larger than any chunk: a chunk of its own
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(large) % HugePageMemory::kHugePage, 0u);
+  static_cast<char*>(large)[(std::size_t{100} << 20) - 1] = 1;
+}
+
+TEST(LinkRows, CopiesIntoAnArenaOfTheirOwnAndMovesTheirs) {
+  LinkRows<DenseSlotMap<double>> rows;
+  for (std::size_t i = 0; i < 3; ++i) rows.append();
+  for (std::size_t k = 0; k < 500; ++k) rows[k % 3].try_emplace(k, static_cast<double>(k));
+  auto copy = std::make_unique<LinkRows<DenseSlotMap<double>>>(rows);
+  LinkRows<DenseSlotMap<double>> moved = std::move(rows);
+  copy->truncate(2);
+  moved[1].try_emplace(10000, 1.0);
+  EXPECT_EQ(copy->size(), 2u);
+  EXPECT_EQ((*copy)[1].size(), 167u);
+  EXPECT_EQ(moved[1].size(), 168u);
+  moved = *copy;  // copy-assignment frees the moved rows into their arena, then drops it
+  copy.reset();
+  EXPECT_EQ(moved.size(), 2u);
+  EXPECT_EQ(moved[0].find(3)->second, 3.0);
+  rows.append();  // a moved-from LinkRows gets a new arena
+  rows[0].try_emplace(1, 1.0);
+  EXPECT_EQ(rows.size(), 1u);
+  EXPECT_GT(rows.memory_bytes(), 0u);
 }
 
 TEST(DenseSlotMap, EntriesCanBeChangedInPlace) {

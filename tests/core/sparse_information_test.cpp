@@ -4,6 +4,8 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cstdint>
+#include <memory>
 #include <map>
 #include <random>
 #include <vector>
@@ -146,19 +148,48 @@ TEST(SparseInformation, SaysWhetherMarginalizingASlotAddsLinks) {
   EXPECT_GT(with_fill, 20u);
 }
 
+TEST(SparseInformation, CopiesAndMovesKeepTheLinksWhoeverOwnedTheirMemory) {
+  // The link maps live in an arena of their SparseInformation (core/link_rows.hpp): a copy must own
+  // its own, outlive the original and not share changes with it; a move or a move-assignment over a
+  // form with links of its own must keep the moved links and free the replaced ones (ASan and the
+  // sanitized test run check the freeing).
+  std::mt19937 rng(5);
+  auto original = std::make_unique<Info>(random_form(40, rng));
+  const Eigen::MatrixXd expected = Eigen::MatrixXd(original->to_sparse());
+  Info copy = *original;
+  Info assigned = random_form(10, rng);
+  assigned = *original;
+  original->add_to_link(0, 1, Block::Identity());
+  original.reset();
+  EXPECT_EQ(Eigen::MatrixXd(copy.to_sparse()), expected);
+  EXPECT_EQ(Eigen::MatrixXd(assigned.to_sparse()), expected);
+  Info moved = std::move(copy);
+  Info replaced = random_form(25, rng);
+  replaced = std::move(assigned);
+  EXPECT_EQ(Eigen::MatrixXd(moved.to_sparse()), expected);
+  EXPECT_EQ(Eigen::MatrixXd(replaced.to_sparse()), expected);
+  for (std::size_t i = 0; i < 40; ++i) moved.add_to_link(i, (i + 7) % 40, Block::Identity());  // grows maps
+  EXPECT_EQ(Eigen::MatrixXd(replaced.to_sparse()), expected);
+}
+
 TEST(SquareWorkspace, HandsOutViewsOfOneBufferAndCopiesEmpty) {
   SquareWorkspace workspace;
   auto small = workspace.view(10);
   EXPECT_EQ(small.rows(), 10);
   EXPECT_EQ(small.cols(), 10);
   const std::size_t bytes = workspace.memory_bytes();
-  EXPECT_EQ(bytes, 100 * sizeof(double));
+  EXPECT_EQ(bytes, 832u);  // 100 doubles, rounded up to a cache line
   workspace.view(8);
   EXPECT_EQ(workspace.memory_bytes(), bytes);  // no reallocation for a smaller block
   workspace.view(11);
   EXPECT_EQ(workspace.memory_bytes(), 12 * 12 * sizeof(double));  // grows by a quarter at least
   const SquareWorkspace copy = workspace;
   EXPECT_EQ(copy.memory_bytes(), 0u);  // scratch is not state
+  // From 2 MB on: whole huge pages, aligned to one, the column stride the capacity.
+  const auto large = workspace.view(600);
+  EXPECT_EQ(workspace.memory_bytes(), 2 * HugePageMemory::kHugePage);  // 600^2 doubles = 2.9 MB
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(large.data()) % HugePageMemory::kHugePage, 0u);
+  EXPECT_EQ(large.outerStride(), 600);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory_resource>
 #include <utility>
 #include <vector>
 
@@ -17,8 +18,15 @@ template <class Value>
 class DenseSlotMap {
  public:
   using Entry = std::pair<std::size_t, Value>;
-  using iterator = typename std::vector<Entry>::iterator;
-  using const_iterator = typename std::vector<Entry>::const_iterator;
+  using iterator = typename std::pmr::vector<Entry>::iterator;
+  using const_iterator = typename std::pmr::vector<Entry>::const_iterator;
+
+  /// The entries and the index live in `memory` (a copy lives in the default resource, as any
+  /// std::pmr container's; the copy below chooses).
+  explicit DenseSlotMap(std::pmr::memory_resource* memory = std::pmr::get_default_resource())
+      : entries_(memory), index_(memory) {}
+  DenseSlotMap(const DenseSlotMap& other, std::pmr::memory_resource* memory)
+      : entries_(other.entries_, memory), index_(other.index_, memory), shift_(other.shift_) {}
 
   std::size_t size() const { return entries_.size(); }
   bool empty() const { return entries_.empty(); }
@@ -136,8 +144,8 @@ class DenseSlotMap {
       index_[free_position_for(entries_[e].first)] = static_cast<std::uint32_t>(e + 1);
   }
 
-  std::vector<Entry> entries_;
-  std::vector<std::uint32_t> index_;  ///< 0 = empty, else entry number + 1
+  std::pmr::vector<Entry> entries_;
+  std::pmr::vector<std::uint32_t> index_;  ///< 0 = empty, else entry number + 1
   int shift_ = 64;
 };
 

@@ -21,6 +21,7 @@
 #include "sextant/core/block_triplets.hpp"
 #include "sextant/core/dense_slot_map.hpp"
 #include "sextant/core/error.hpp"
+#include "sextant/core/link_rows.hpp"
 
 namespace sextant {
 
@@ -145,7 +146,7 @@ class SparseInformation {
   /// Appends a landmark with no information and no links; returns its slot.
   std::size_t append_landmark() {
     diagonal_.push_back(LandmarkBlock::Zero());
-    links_.emplace_back();
+    links_.append();
     saved_in_.push_back(0);
     landmark_residual_.conservativeResize(landmark_residual_.size() + M);
     landmark_residual_.template tail<M>().setZero();
@@ -254,7 +255,7 @@ class SparseInformation {
   RobotVector robot_residual_;
   std::unordered_map<std::size_t, CrossBlock> robot_links_;
   std::vector<LandmarkBlock> diagonal_;
-  std::vector<Links> links_;
+  LinkRows<Links> links_;  ///< per slot, in one arena of huge pages
   Eigen::VectorXd landmark_residual_;
   Journal journal_;  ///< the open transaction's record (open_), kept allocated between transactions
   bool open_ = false;
@@ -285,7 +286,7 @@ void SparseInformation<X, M>::rollback() {
     }
   }
   diagonal_.resize(journal.landmarks);
-  links_.resize(journal.landmarks);
+  links_.truncate(journal.landmarks);
   saved_in_.resize(journal.landmarks);
   landmark_residual_.conservativeResize(M * static_cast<Eigen::Index>(journal.landmarks));
   for (const auto& saved : journal.slots) {
@@ -385,10 +386,8 @@ std::size_t SparseInformation<X, M>::memory_bytes() const {
   constexpr std::size_t node_overhead = 2 * sizeof(void*) + sizeof(std::size_t);  // hash node: next, key, hash
   std::size_t bytes = sizeof(*this) + diagonal_.capacity() * sizeof(LandmarkBlock) +
                       static_cast<std::size_t>(landmark_residual_.size()) * sizeof(double) +
-                      links_.capacity() * sizeof(Links) +
-                      robot_links_.size() * (sizeof(CrossBlock) + node_overhead) +
+                      links_.memory_bytes() + robot_links_.size() * (sizeof(CrossBlock) + node_overhead) +
                       robot_links_.bucket_count() * sizeof(void*);
-  for (const auto& links : links_) bytes += links.memory_bytes();
   bytes += journal_.slots.capacity() * sizeof(SavedSlot) + journal_.robot_links.capacity() * sizeof(SavedRobotLink) +
            journal_.links.capacity() * sizeof(SavedLink);
   return bytes;

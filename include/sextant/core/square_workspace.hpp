@@ -3,10 +3,14 @@
 /// corner of one buffer that grows (by at least a quarter) only when d exceeds it. A filter step
 /// that factorizes a dense block of varying size (SEIF's robot-and-active block, ~800 dimensions at
 /// the thesis's scale) then allocates, and page-faults, a few times in a run instead of every step.
-/// Copies start empty: scratch is not state.
+/// Copies start empty: scratch is not state. From 2 MB on the buffer is backed by huge pages
+/// (core/huge_pages.hpp): the block's 3 x 3 sub-blocks are read across columns a few KB apart, one
+/// 4 KB page each, which in a virtual machine was a TLB miss each.
 
 #include <Eigen/Core>
 #include <algorithm>
+
+#include "sextant/core/huge_pages.hpp"
 
 namespace sextant {
 
@@ -19,20 +23,24 @@ class SquareWorkspace {
   SquareWorkspace& operator=(SquareWorkspace&&) noexcept = default;
   ~SquareWorkspace() = default;
 
-  /// The d x d view; its contents are unspecified. Views handed out before are invalidated when
-  /// the buffer grows.
-  Eigen::Block<Eigen::MatrixXd> view(Eigen::Index d) {
-    if (d > buffer_.rows()) {
-      const Eigen::Index capacity = std::max(d, buffer_.rows() + buffer_.rows() / 4);
-      buffer_.resize(capacity, capacity);
+  using View = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
+
+  /// The d x d view (column stride: the capacity); its contents are unspecified. Views handed out
+  /// before are invalidated when the buffer grows.
+  View view(Eigen::Index d) {
+    if (d > capacity_) {
+      const Eigen::Index capacity = std::max(d, capacity_ + capacity_ / 4);
+      buffer_ = HugePageMemory(static_cast<std::size_t>(capacity * capacity) * sizeof(double));
+      capacity_ = capacity;
     }
-    return buffer_.topLeftCorner(d, d);
+    return View(reinterpret_cast<double*>(buffer_.data()), d, d, Eigen::OuterStride<>(capacity_));
   }
   /// Heap bytes held.
-  std::size_t memory_bytes() const { return static_cast<std::size_t>(buffer_.size()) * sizeof(double); }
+  std::size_t memory_bytes() const { return buffer_.size(); }
 
  private:
-  Eigen::MatrixXd buffer_;
+  HugePageMemory buffer_;
+  Eigen::Index capacity_ = 0;
 };
 
 }  // namespace sextant
