@@ -190,6 +190,15 @@ TEST(SquareWorkspace, HandsOutViewsOfOneBufferAndCopiesEmpty) {
   EXPECT_EQ(workspace.memory_bytes(), 2 * HugePageMemory::kHugePage);  // 600^2 doubles = 2.9 MB
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(large.data()) % HugePageMemory::kHugePage, 0u);
   EXPECT_EQ(large.outerStride(), 600);
+  SquareWorkspace moved = std::move(workspace);  // the buffer and its capacity go together
+  EXPECT_EQ(moved.memory_bytes(), 2 * HugePageMemory::kHugePage);
+  EXPECT_EQ(workspace.memory_bytes(), 0u);
+  EXPECT_EQ(workspace.view(20).outerStride(), 20);  // a moved-from workspace allocates afresh
+  workspace.view(20).setZero();
+  moved = std::move(workspace);
+  EXPECT_EQ(moved.view(20).outerStride(), 20);
+  EXPECT_EQ(workspace.view(30).outerStride(), 30);
+  workspace.view(30).setZero();
 }
 
 }  // namespace

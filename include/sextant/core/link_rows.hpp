@@ -30,7 +30,6 @@ class LinkRows {
   std::size_t size() const { return rows_.size(); }
   Row& operator[](std::size_t slot) { return rows_[slot]; }
   const Row& operator[](std::size_t slot) const { return rows_[slot]; }
-  Row& back() { return rows_.back(); }
 
   /// Appends an empty row (a moved-from LinkRows gets a new arena first).
   void append() {

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <utility>
 
 #include "sextant/core/huge_pages.hpp"
 
@@ -19,8 +20,14 @@ class SquareWorkspace {
   SquareWorkspace() = default;
   SquareWorkspace(const SquareWorkspace&) {}
   SquareWorkspace& operator=(const SquareWorkspace&) { return *this; }
-  SquareWorkspace(SquareWorkspace&&) noexcept = default;
-  SquareWorkspace& operator=(SquareWorkspace&&) noexcept = default;
+  /// A moved-from workspace is empty (its capacity goes with the buffer).
+  SquareWorkspace(SquareWorkspace&& other) noexcept
+      : buffer_(std::move(other.buffer_)), capacity_(std::exchange(other.capacity_, 0)) {}
+  SquareWorkspace& operator=(SquareWorkspace&& other) noexcept {
+    buffer_ = std::move(other.buffer_);
+    capacity_ = std::exchange(other.capacity_, 0);
+    return *this;
+  }
   ~SquareWorkspace() = default;
 
   using View = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
