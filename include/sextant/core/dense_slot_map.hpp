@@ -5,6 +5,9 @@
 /// that walk into a cache miss per link (at the globe's thesis scale, 80% of mean recovery's time
 /// was spent loading hash nodes). Iteration visits entries in vector order; erasing moves the last
 /// entry into the hole, so the order is not the insertion order and no algorithm may depend on it.
+/// The entries grow by half when full (from 8 on): at the thesis's globe scale the maps' capacity was
+/// 1.47x their entries with doubling, and the memory a run first touches is what SEIF's
+/// sparsification waits for on a virtual machine (docs/benchmarks.md, round seven).
 
 #include <cstddef>
 #include <cstdint>
@@ -49,6 +52,8 @@ class DenseSlotMap {
   std::pair<iterator, bool> try_emplace(std::size_t key, const Value& value) {
     if (const auto it = find(key); it != end()) return {it, false};
     if (2 * (entries_.size() + 1) > index_.size()) grow();
+    if (entries_.size() == entries_.capacity() && entries_.size() >= 8)  // grow by half, not double
+      entries_.reserve(entries_.size() + entries_.size() / 2);
     entries_.emplace_back(key, value);
     index_[free_position_for(key)] = static_cast<std::uint32_t>(entries_.size());
     return {entries_.end() - 1, true};
