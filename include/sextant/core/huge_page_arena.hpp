@@ -1,8 +1,8 @@
 #pragma once
-/// \file A memory resource for many buffers that grow by doubling and live as long as one owner:
+/// \file A memory resource for many buffers that grow by one rule and live as long as one owner:
 /// blocks are carved from chunks that double in size up to 64 MB, from 2 MB on backed by huge
 /// pages (core/huge_pages.hpp), and a freed block waits for the next request of its size (a buffer
-/// that doubles frees exactly the sizes the next buffers ask for).
+/// that grows by the rule frees exactly the sizes the buffers behind it will ask for).
 /// SEIF's landmark links are such buffers: at the thesis's globe scale ~3,800 link maps grow to ~900
 /// entries each, ~450 MB first touched over the run, and with 4 KB pages each first touch was a page
 /// fault (a fifth of SEIF's run on a virtual machine) and each look-up in a cold map a TLB miss.
