@@ -33,11 +33,12 @@ class HugePageArena final : public std::pmr::memory_resource {
   static constexpr std::size_t kFirstChunk = std::size_t{64} << 10;  ///< a small map costs no huge page
   static constexpr std::size_t kLargestChunk = std::size_t{64} << 20;
 
-  static std::size_t round_up(std::size_t bytes, std::size_t to) { return (bytes + to - 1) / to * to; }
+  /// The block a request of `bytes` gets (its free list's key).
+  static std::size_t block_size(std::size_t bytes) { return round_up_to(std::max<std::size_t>(bytes, 1), kGranule); }
 
   void* do_allocate(std::size_t bytes, std::size_t alignment) override {
     if (alignment > kGranule) return std::pmr::new_delete_resource()->allocate(bytes, alignment);
-    const std::size_t size = round_up(std::max<std::size_t>(bytes, 1), kGranule);
+    const std::size_t size = block_size(bytes);
     if (void*& waiting = free_[size]; waiting != nullptr) {  // the key exists from here on
       void* block = waiting;
       waiting = *static_cast<void**>(block);
@@ -52,7 +53,7 @@ class HugePageArena final : public std::pmr::memory_resource {
   }
   void do_deallocate(void* block, std::size_t bytes, std::size_t alignment) override {
     if (alignment > kGranule) return std::pmr::new_delete_resource()->deallocate(block, bytes, alignment);
-    void*& waiting = free_.find(round_up(std::max<std::size_t>(bytes, 1), kGranule))->second;  // allocate made the key
+    void*& waiting = free_.find(block_size(bytes))->second;  // allocate made the key
     *static_cast<void**>(block) = waiting;
     waiting = block;
   }

@@ -17,6 +17,9 @@
 
 namespace sextant {
 
+/// `bytes` rounded up to a multiple of `to`.
+constexpr std::size_t round_up_to(std::size_t bytes, std::size_t to) { return (bytes + to - 1) / to * to; }
+
 class HugePageMemory {
  public:
   static constexpr std::size_t kHugePage = std::size_t{2} << 20;
@@ -25,7 +28,7 @@ class HugePageMemory {
   /// At least `bytes` bytes (rounded up to 64, or to 2 MB from 2 MB on); contents uninitialized.
   explicit HugePageMemory(std::size_t bytes) {
     const std::size_t alignment = bytes >= kHugePage ? kHugePage : 64;
-    size_ = (bytes + alignment - 1) / alignment * alignment;
+    size_ = round_up_to(bytes, alignment);
     data_ = static_cast<std::byte*>(std::aligned_alloc(alignment, size_));
     if (data_ == nullptr) throw std::bad_alloc();
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
