@@ -17,4 +17,8 @@ sim::GlobeCameraOptions globe_options(const GlobeSettings& s);
 std::vector<TableRow> run_globe_dataset(const RunOptions& options, const std::string& name, const sim::GlobeCameraDataset& data,
                                         const std::vector<BackendKind>& kinds, const RunnerConfig& config);
 
+/// Prints how far the prior's mean lies from the true first pose (once a run: the stereo run's
+/// reference shares its start).
+void print_start_draw(const sim::GlobeCameraDataset& data);
+
 }  // namespace sextant::runner

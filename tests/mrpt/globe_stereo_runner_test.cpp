@@ -69,6 +69,10 @@ TEST_F(GlobeStereoRunner, AnEseifTrackerTracksAndOneWithoutAnActiveCountIsRefuse
   ASSERT_EQ(r.exit_code, 0) << r.err;
   for (const char* text : {"ESEIF back-end", "association precision", "ESEIF-SLAM, 150 active"})
     EXPECT_NE(r.out.find(text), std::string::npos) << text << " missing from:\n" << r.out;
+  const std::string start = "The start: the prior's position is";  // once: the reference run shares the start
+  const auto first_start = r.out.find(start);
+  ASSERT_NE(first_start, std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(start, first_start + 1), std::string::npos) << r.out;
 
   const auto none = dir / "none.ini";
   std::ofstream(none) << "[globe]\nsteps = 8\ntracker = eseif\neseif_active = none\n";

@@ -308,6 +308,7 @@ std::vector<TableRow> run_globe_stereo(const CliOptions& cli, const std::string&
     std::printf("\nfor comparison, the point simulator (--dataset globe) on the same trajectory, EKF:\n");
     const auto reference = run_globe_dataset(options, "globe", points, {BackendKind::ekf}, config);
     rows.insert(rows.end(), reference.begin(), reference.end());
+    print_start_draw(stereo);
     return rows;
   });
 }
