@@ -10,6 +10,7 @@
 
 #include "sextant/sim/globe_render.hpp"
 #include "sextant/vision/features.hpp"
+#include "sextant/vision/globe_calibration.hpp"
 #include "sextant/vision/gray_image_view.hpp"
 #include "sextant/vision/opencv_threads.hpp"
 #include "sextant/vision/stereo_front_end.hpp"
@@ -50,7 +51,7 @@ void BM_StereoFrontEnd(benchmark::State& state) {
   const vision::OpenCvThreads one_thread(1);
   const auto& pairs = rendered_pairs();
   const sim::GlobeCameraOptions o;
-  const vision::StereoRig rig{o.stereo.focal_px, 0.5 * o.image_width, 0.5 * o.image_height, o.stereo.baseline};
+  const vision::StereoRig rig = vision::globe_rig(o);
   vision::FrontEndOptions options{.detector = detector_of(state), .slanted_correlation = true};
   options.slanted.drop_unmeasured = true;
   vision::StereoFrontEnd front_end(rig, options);

@@ -19,6 +19,7 @@
 #include "sextant/core/landmark_pool_policy.hpp"
 #include "sextant/sim/globe_render.hpp"
 #include "sextant/eval/globe_association_truth.hpp"
+#include "sextant/vision/globe_calibration.hpp"
 #include "sextant/vision/gray_image_view.hpp"
 #include "sextant/vision/stereo_sequence.hpp"
 #include "sextant/vision/stereo_sequence_tracking.hpp"
@@ -30,10 +31,6 @@ namespace {
 using Ekf = EkfSlam<EulerCamera12D, PointInCamera3D>;
 using Seif = SeifSlam<EulerCamera12D, PointInCamera3D>;
 using Tracker = StereoTracker<Ekf>;
-
-StereoRig rig_of(const sim::GlobeCameraOptions& o) {
-  return {o.stereo.focal_px, 0.5 * o.image_width, 0.5 * o.image_height, o.stereo.baseline};
-}
 
 /// A fresh directory under the test's temporary directory.
 std::filesystem::path scratch_dir(const std::string& name) {
@@ -63,7 +60,7 @@ double point_simulator_mae(const sim::GlobeCameraDataset& data) {
 template <class Backend>
 void expect_tracks_the_camera(Backend backend, const sim::GlobeCameraOptions& o, const sim::GlobeCameraDataset& data,
                               const char* name) {
-  StereoTracker<Backend> tracker(std::move(backend), data.sensor, rig_of(o), o.image_width, o.image_height);
+  StereoTracker<Backend> tracker(std::move(backend), data.sensor, globe_rig(o), o.image_width, o.image_height);
   eval::GlobeAssociationTruth truth(o);
   double position_error = 0.0;
   std::size_t later_observations = 0, later_new = 0, created = 0;
@@ -136,9 +133,9 @@ TEST(GlobeStereoPipeline, SeifConditionalGateKeepsWhatTheExactGateKeeps) {
   for (std::size_t k = 0; k < data.steps.size(); ++k) {
     seif.predict(data.steps[k].control, data.steps[k].dt);
     if (k % 5 == 4) {
-      const auto exact = predict_landmarks_in_view(seif, data.sensor, rig_of(o), o.image_width, o.image_height,
+      const auto exact = predict_landmarks_in_view(seif, data.sensor, globe_rig(o), o.image_width, o.image_height,
                                                    GateCovariance::joint_marginal);
-      const auto conditional = predict_landmarks_in_view(seif, data.sensor, rig_of(o), o.image_width, o.image_height,
+      const auto conditional = predict_landmarks_in_view(seif, data.sensor, globe_rig(o), o.image_width, o.image_height,
                                                          GateCovariance::conditional);
       ASSERT_EQ(exact.size(), conditional.size());
       std::unordered_map<LandmarkId, std::size_t> at;
@@ -170,14 +167,7 @@ TEST(GlobeStereoPipeline, SavedSequenceGivesTheSameObservationsAsTheRenderedRun)
   o.num_steps = 6;
   const auto data = sim::simulate_globe_camera(o);
   const auto dir = scratch_dir("stereo_round_trip");
-  StereoCalibration calibration;
-  calibration.K << o.stereo.focal_px, 0, 0.5 * o.image_width, 0, o.stereo.focal_px, 0.5 * o.image_height, 0, 0, 1;
-  calibration.baseline = o.stereo.baseline;
-  calibration.width = o.image_width;
-  calibration.height = o.image_height;
-  calibration.dt = o.dt;
-  calibration.initial_state = data.prior.mean;
-  calibration.initial_sigma = data.prior.cov.diagonal().cwiseSqrt();
+  const StereoCalibration calibration = globe_calibration(o, data.prior);
   write_calibration(dir, calibration);
 
   Tracker rendered(Ekf(data.motion, data.sensor, data.prior), data.sensor, calibration.rig(), o.image_width, o.image_height);
@@ -251,7 +241,7 @@ TEST(GlobeStereoPipeline, PipelinedTrackingGivesTheFramesOfOneAfterAnother) {
     pairs.push_back({as_mat(images.left).clone(), as_mat(images.right).clone()});
   }
   auto run = [&](bool pipelined, std::size_t bad_pair) {
-    Tracker tracker(Ekf(data.motion, data.sensor, data.prior), data.sensor, rig_of(o), o.image_width, o.image_height);
+    Tracker tracker(Ekf(data.motion, data.sensor, data.prior), data.sensor, globe_rig(o), o.image_width, o.image_height);
     std::vector<TrackedFrame> seen;
     auto pair_of = [&](std::size_t k) { return k == bad_pair ? StereoPair{pairs[k].left, cv::Mat(10, 10, CV_8UC1)} : pairs[k]; };
     bool threw = false;
@@ -369,7 +359,7 @@ TEST(StereoSequence, BadDirectoriesGiveOneErrorNamingTheFile) {
 TEST(StereoSequence, AFrameWithoutFeaturesIsAStepWithoutObservations) {
   sim::GlobeCameraOptions o;
   const auto data = sim::simulate_globe_camera(o);
-  Tracker tracker(Ekf(data.motion, data.sensor, data.prior), data.sensor, rig_of(o), o.image_width, o.image_height);
+  Tracker tracker(Ekf(data.motion, data.sensor, data.prior), data.sensor, globe_rig(o), o.image_width, o.image_height);
   const cv::Mat blank(o.image_height, o.image_width, CV_8UC1, cv::Scalar(90));
   const auto frame = tracker.track(blank, blank, {}, o.dt);
   EXPECT_TRUE(frame.observations.empty());

@@ -15,6 +15,7 @@
 
 #include "sextant/sim/globe_render.hpp"
 #include "sextant/vision/features.hpp"
+#include "sextant/vision/globe_calibration.hpp"
 #include "sextant/vision/gray_image_view.hpp"
 #include "sextant/vision/row_search_matching.hpp"
 #include "sextant/vision/slanted_correlation.hpp"
@@ -28,7 +29,7 @@ namespace {
 struct RenderedPair {
   sim::GlobeCameraOptions options;
   Vector12d pose;
-  StereoRig rig{options.stereo.focal_px, 0.5 * options.image_width, 0.5 * options.image_height, options.stereo.baseline};
+  StereoRig rig = globe_rig(options);
   sim::StereoImages images;
 
   explicit RenderedPair(const Vector12d& x) : pose(x), images(sim::render_stereo(options, pose)) {}

@@ -14,6 +14,7 @@
 #include <sextant/io/tum_writer.hpp>
 #include <sextant/sim/globe_render.hpp>
 #include <sextant/eval/globe_association_truth.hpp>
+#include <sextant/vision/globe_calibration.hpp>
 #include <sextant/vision/gray_image_view.hpp>
 #include <sextant/vision/opencv_threads.hpp>
 #include <sextant/vision/stereo_sequence.hpp>
@@ -227,18 +228,6 @@ vision::SequenceClock track_frames(Tracker& tracker, std::size_t n, PairOf&& pai
   return vision::track_sequence(tracker, n, pair_of, dt_of, on_frame, config.globe.pipelined);
 }
 
-vision::StereoCalibration calibration_of(const sim::GlobeCameraOptions& o, const Gaussian<Vector12d, 12>& prior) {
-  vision::StereoCalibration c;
-  c.K << o.stereo.focal_px, 0, 0.5 * o.image_width, 0, o.stereo.focal_px, 0.5 * o.image_height, 0, 0, 1;
-  c.baseline = o.stereo.baseline;
-  c.width = o.image_width;
-  c.height = o.image_height;
-  c.dt = o.dt;
-  c.initial_state = prior.mean;
-  c.initial_sigma = prior.cov.diagonal().cwiseSqrt();
-  return c;
-}
-
 /// The globe rendered as stereo images, the front-end, then every back-end on its observations and,
 /// for comparison, the EKF on the point simulator's observations of the same trajectory; with
 /// --save-images the rendered sequence is also written there (stereo:<dir> layout).
@@ -254,7 +243,7 @@ std::vector<TableRow> run_globe_stereo(const CliOptions& cli, const std::string&
               static_cast<unsigned long long>(config.globe.texture_seed), o.num_steps,
               config.globe.orb ? "ORB" : "AKAZE", config.globe.pool.max_landmarks, config.globe.pool.max_new_per_step,
               config.globe.features_per_frame);
-  const auto calibration = calibration_of(o, points.prior);
+  const auto calibration = vision::globe_calibration(o, points.prior);
   if (!save_images.empty()) vision::write_calibration(save_images, calibration);
   PointInCamera3D image_sensor = points.sensor;  // the observations' noise as the front-end measures them
   image_sensor.noise.disparity_sigma = config.globe.disparity_sigma;
