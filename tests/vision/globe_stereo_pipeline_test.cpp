@@ -7,8 +7,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 #include <random>
 #include <string>
 #include <unordered_map>
@@ -396,7 +398,8 @@ TEST(MapAssociation, AFeaturesNoiseScaleWidensItsGate) {
     StereoFrame frame = hand_made_frame({{{0.06, 0, 1}, 0x00}});
     frame.features[0].noise_scale = scale;
     LandmarkId next = 100;
-    const auto a = associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance, next, {});
+    const auto a = associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance, next,
+                                    {.max_descriptor_distance = 60});
     ASSERT_EQ(a.observations.size(), 1u);
     EXPECT_EQ(a.observations[0].landmark_id, scale == 1.0 ? 100u : 7u) << scale;
     EXPECT_EQ(a.observations[0].noise_scale, scale);  // handed on to the back-end
@@ -417,7 +420,7 @@ TEST(MapAssociation, AReobservationsStudentTScaleFollowsItsInnovation) {
       for (auto& f : frame.features) f.noise_scale = feature_scale;
       LandmarkId next = 100;
       const auto a = associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance, next,
-                                      {.student_t_dof = 4.0});
+                                      {.student_t_dof = 4.0, .max_descriptor_distance = 60});
       ASSERT_EQ(a.associated, 1u);
       ASSERT_EQ(a.created, 1u);
       const double nis = offset * offset / (1e-4 * (1.0 + feature_scale * feature_scale));
@@ -428,7 +431,7 @@ TEST(MapAssociation, AReobservationsStudentTScaleFollowsItsInnovation) {
   LandmarkId next = 100;
   for (const double bad : {-1.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()})
     EXPECT_THROW((void)associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance, next,
-                                        {.student_t_dof = bad}),
+                                        {.student_t_dof = bad, .max_descriptor_distance = 60}),
                  invalid_input_error);
 }
 
@@ -445,7 +448,7 @@ TEST(MapAssociation, OnlyALandmarkLikelierThanANewPointKeepsAnUnmatchedFeatureOu
       const std::vector<PredictedLandmark> predicted = {{7, {0, 0, 1}, Eigen::Matrix3d::Identity() / (sigma * sigma)}};
       LandmarkId next = 100;
       const auto a = associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance, next,
-                                      {.new_landmark_density = density});
+                                      {.new_landmark_density = density, .max_descriptor_distance = 60});
       const bool made_new = sigma > 1.0 && density > 0.0;
       EXPECT_EQ(a.created, made_new ? 1u : 0u) << sigma << " m, density " << density;
       EXPECT_EQ(a.gated_unmatched, made_new ? 0u : 1u) << sigma << " m, density " << density;
@@ -454,7 +457,7 @@ TEST(MapAssociation, OnlyALandmarkLikelierThanANewPointKeepsAnUnmatchedFeatureOu
   LandmarkId next = 100;
   for (const double bad : {-1.0, std::numeric_limits<double>::quiet_NaN()})
     EXPECT_THROW((void)associate_to_map(frame, std::span<const PredictedLandmark>(none), appearance, next,
-                                        {.new_landmark_density = bad}),
+                                        {.new_landmark_density = bad, .max_descriptor_distance = 60}),
                  invalid_input_error);
 }
 
@@ -589,6 +592,35 @@ TEST(MapAssociation, GateThenDescriptorOneFeaturePerLandmark) {
                                               {.max_descriptor_distance = 10, .ratio = 1.0});
   ASSERT_EQ(without_ratio.associated, 1u);
   EXPECT_EQ(without_ratio.observations[0].landmark_id, 7u);
+  // The bound is the caller's to set: unset, not finite or not > 0 is refused, not read as "any".
+  for (const std::optional<double> bad : {std::optional<double>(), std::optional<double>(0.0), std::optional<double>(-1.0),
+                                          std::optional<double>(std::numeric_limits<double>::quiet_NaN())})
+    EXPECT_THROW((void)associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance, next,
+                                        {.max_descriptor_distance = bad}),
+                 invalid_input_error);
+}
+
+/// A tracker's association bound is its detector's unless set (60 bits would let every pair of KAZE's
+/// unit-length float descriptors through); a bad one is refused before any frame.
+TEST(MapAssociation, TheTrackersDescriptorBoundIsItsDetectorsUnlessSet) {
+  const sim::GlobeCameraOptions o;
+  const auto data = sim::simulate_globe_camera([] {
+    sim::GlobeCameraOptions few;
+    few.num_steps = 1;
+    return few;
+  }());
+  const auto tracker_with = [&](Detector detector, std::optional<double> bound) {
+    StereoTrackerOptions options;
+    options.front_end.detector.detector = detector;
+    options.association.max_descriptor_distance = bound;
+    return Tracker(Ekf(data.motion, data.sensor, data.prior), data.sensor, globe_rig(o), o.image_width, o.image_height,
+                   options);
+  };
+  for (const Detector detector : {Detector::akaze, Detector::orb, Detector::kaze})
+    EXPECT_EQ(tracker_with(detector, std::nullopt).options().association.max_descriptor_distance,
+              default_max_descriptor_distance(detector));
+  EXPECT_EQ(tracker_with(Detector::kaze, 0.2).options().association.max_descriptor_distance, 0.2);
+  EXPECT_THROW((void)tracker_with(Detector::orb, -1.0), invalid_input_error);
 }
 
 }  // namespace

@@ -187,7 +187,6 @@ vision::StereoTrackerOptions tracker_options(const RunnerConfig& c, const PointI
   o.front_end.detector.threshold = static_cast<float>(c.globe.detector_threshold);
   if (c.globe.orb) o.front_end.detector.detector = vision::Detector::orb;
   o.front_end.detector.orb_levels = c.globe.orb_levels;
-  o.association.max_descriptor_distance = vision::default_max_descriptor_distance(o.front_end.detector.detector);
   if (c.globe.row_search) o.front_end.correspondence = vision::StereoCorrespondence::row_search;
   o.front_end.right_refinement.radius = c.globe.right_refinement_px;
   o.front_end.slanted_correlation = c.globe.slanted_correlation;

@@ -47,13 +47,28 @@ struct MapAssociationOptions {
   /// patches differ in about half), L2 for KAZE's unit-length float descriptors (set it near 0.3).
   /// On the rendered globe (300 frames, docs/results/globe_stereo.md) 60 with the ratio test at 0.8
   /// gave 99.99% right associations and EKF position MAE 3.5 mm; 90 without the test 99.96%, 5.3 mm.
-  /// Another detector's value: vision::default_max_descriptor_distance (vision/features.hpp).
-  double max_descriptor_distance = 60.0;
+  /// Unset: the detector's value, vision::default_max_descriptor_distance (vision/features.hpp),
+  /// which StereoTracker fills in from its front-end's detector (a value that suits one descriptor is
+  /// meaningless for another: 60 bits let every pair of KAZE's float descriptors through). A caller
+  /// of the association functions below sets it.
+  std::optional<double> max_descriptor_distance;
   /// A feature's nearest landmark descriptor among those in whose gate it lies must be nearer than
   /// ratio x the second nearest (Lowe's test); 1 turns the test off.
   double ratio = 0.8;
   std::size_t max_observations = 120;  ///< per frame: associated features first, then new ones
 };
+
+/// The largest descriptor distance of a pair; throws invalid_input_error when it is unset, not
+/// finite or not > 0.
+inline double descriptor_distance_bound(const MapAssociationOptions& o) {
+  if (!o.max_descriptor_distance)
+    throw invalid_input_error("map association: max_descriptor_distance is unset (vision::default_max_descriptor_distance "
+                              "gives the detector's value)");
+  const double bound = *o.max_descriptor_distance;
+  if (!(bound > 0.0) || !std::isfinite(bound))
+    throw invalid_input_error("map association: max_descriptor_distance " + std::to_string(bound) + " must be finite and > 0");
+  return bound;
+}
 
 /// Which covariance of the robot and a landmark the gate's innovation covariance S comes from.
 enum class GateCovariance {
@@ -227,6 +242,7 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
                                                          const LandmarkAppearance& appearance,
                                                          const MapAssociationOptions& o, std::vector<bool>& gated) {
   const double gate = chi_square_quantile(3, o.gate_probability);
+  const double max_distance = descriptor_distance_bound(o);
   gated.assign(frame.features.size(), false);
   std::vector<NearestTwo<FeaturePair>> nearest(frame.features.size());
   std::vector<double> xs;  // a landmark's gate can only hold the features whose x lies within its reach
@@ -259,7 +275,7 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
   }
   std::vector<FeaturePair> pairs;
   for (const auto& n : nearest)
-    if (n.best <= o.max_descriptor_distance && (o.ratio >= 1.0 || n.clearly_nearest(o.ratio))) pairs.push_back(n.nearest);
+    if (n.best <= max_distance && (o.ratio >= 1.0 || n.clearly_nearest(o.ratio))) pairs.push_back(n.nearest);
   return pairs;
 }
 

@@ -73,7 +73,10 @@ class StereoTracker {
   StereoTracker(Backend backend, Sensor sensor, StereoRig rig, int width, int height, StereoTrackerOptions options = {})
       : sensor_(sensor), backend_(std::move(backend)), policy_(options.pool), front_end_(rig, options.front_end),
         width_(width), height_(height), options_(options) {
-    if (options.returning.after_frames > 0) require_valid(options.returning);  // before any frame, not in one
+    auto& max_distance = options_.association.max_descriptor_distance;
+    if (!max_distance) max_distance = default_max_descriptor_distance(options.front_end.detector.detector);
+    (void)descriptor_distance_bound(options_.association);  // refused before any frame, not in one
+    if (options.returning.after_frames > 0) require_valid(options.returning);
   }
 
   /// One frame: features of the pair, motion update over dt, association, pool, measurement update
@@ -140,6 +143,8 @@ class StereoTracker {
     return out;
   }
 
+  /// The options it runs with (the association's descriptor distance filled in when unset).
+  const StereoTrackerOptions& options() const { return options_; }
   const Backend& backend() const { return backend_; }
   const LandmarkPoolPolicy& pool() const { return policy_; }
   const StereoFrontEnd& front_end() const { return front_end_; }
