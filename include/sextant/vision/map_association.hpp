@@ -309,7 +309,7 @@ inline double reobservation_noise_scale(double feature_scale, double nis, const 
 /// next_id, next_id + 1, ... (next_id is advanced).
 inline FrameAssociation associate_to_map(const StereoFrame& frame, std::span<const PredictedLandmark> predicted,
                                          const LandmarkAppearance& appearance, LandmarkId& next_id,
-                                         const MapAssociationOptions& o = {}) {
+                                         const MapAssociationOptions& o) {
   if (!(o.new_landmark_density >= 0.0))
     throw invalid_input_error("map association: new_landmark_density " + std::to_string(o.new_landmark_density) +
                               " per m^3 must be >= 0");
