@@ -603,12 +603,9 @@ TEST(MapAssociation, GateThenDescriptorOneFeaturePerLandmark) {
 /// A tracker's association bound is its detector's unless set (60 bits would let every pair of KAZE's
 /// unit-length float descriptors through); a bad one is refused before any frame.
 TEST(MapAssociation, TheTrackersDescriptorBoundIsItsDetectorsUnlessSet) {
-  const sim::GlobeCameraOptions o;
-  const auto data = sim::simulate_globe_camera([] {
-    sim::GlobeCameraOptions few;
-    few.num_steps = 1;
-    return few;
-  }());
+  sim::GlobeCameraOptions o;
+  o.num_steps = 1;
+  const auto data = sim::simulate_globe_camera(o);
   const auto tracker_with = [&](Detector detector, std::optional<double> bound) {
     StereoTrackerOptions options;
     options.front_end.detector.detector = detector;
