@@ -592,12 +592,24 @@ TEST(MapAssociation, GateThenDescriptorOneFeaturePerLandmark) {
                                               {.max_descriptor_distance = 10, .ratio = 1.0});
   ASSERT_EQ(without_ratio.associated, 1u);
   EXPECT_EQ(without_ratio.observations[0].landmark_id, 7u);
+  const LandmarkId next_before_refusals = next;
   // The bound is the caller's to set: unset, not finite or not > 0 is refused, not read as "any".
   for (const std::optional<double> bad : {std::optional<double>(), std::optional<double>(0.0), std::optional<double>(-1.0),
                                           std::optional<double>(std::numeric_limits<double>::quiet_NaN())})
     EXPECT_THROW((void)associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance, next,
                                         {.max_descriptor_distance = bad}),
                  invalid_input_error);
+  // So are a ratio that refuses every pair and a gate outside (0, 1), and next_id stays.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const double bad_ratio : {0.0, -0.5, nan})
+    EXPECT_THROW((void)associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance, next,
+                                        {.max_descriptor_distance = 10, .ratio = bad_ratio}),
+                 invalid_input_error);
+  for (const double bad_gate : {0.0, 1.0, nan})
+    EXPECT_THROW((void)associate_to_map(frame, std::span<const PredictedLandmark>(predicted), appearance, next,
+                                        {.gate_probability = bad_gate, .max_descriptor_distance = 10}),
+                 invalid_input_error);
+  EXPECT_EQ(next, next_before_refusals);
 }
 
 /// A tracker's association bound is its detector's unless set (60 bits would let every pair of KAZE's
@@ -618,6 +630,11 @@ TEST(MapAssociation, TheTrackersDescriptorBoundIsItsDetectorsUnlessSet) {
               default_max_descriptor_distance(detector));
   EXPECT_EQ(tracker_with(Detector::kaze, 0.2).options().association.max_descriptor_distance, 0.2);
   EXPECT_THROW((void)tracker_with(Detector::orb, -1.0), invalid_input_error);
+  StereoTrackerOptions bad_density;  // any bad association option, not only the bound, before any frame
+  bad_density.association.new_landmark_density = -1.0;
+  EXPECT_THROW((void)Tracker(Ekf(data.motion, data.sensor, data.prior), data.sensor, globe_rig(o), o.image_width,
+                             o.image_height, bad_density),
+               invalid_input_error);
 }
 
 }  // namespace

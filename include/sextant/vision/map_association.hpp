@@ -70,6 +70,23 @@ inline double descriptor_distance_bound(const MapAssociationOptions& o) {
   return bound;
 }
 
+/// Throws invalid_input_error naming the first option out of its range (the descriptor bound as
+/// descriptor_distance_bound does); every entry point that takes the options calls it first.
+inline void require_valid(const MapAssociationOptions& o) {
+  if (!(o.gate_probability > 0.0 && o.gate_probability < 1.0))
+    throw invalid_input_error("map association: gate_probability " + std::to_string(o.gate_probability) +
+                              " must be in (0, 1)");
+  if (!(o.new_landmark_density >= 0.0))
+    throw invalid_input_error("map association: new_landmark_density " + std::to_string(o.new_landmark_density) +
+                              " per m^3 must be >= 0");
+  if (!(o.student_t_dof >= 0.0) || !std::isfinite(o.student_t_dof))
+    throw invalid_input_error("map association: student_t_dof " + std::to_string(o.student_t_dof) +
+                              " must be >= 0 and finite (0: Gaussian re-observations)");
+  if (!(o.ratio > 0.0))
+    throw invalid_input_error("map association: ratio " + std::to_string(o.ratio) + " must be > 0 (1 or more: no ratio test)");
+  (void)descriptor_distance_bound(o);
+}
+
 /// Which covariance of the robot and a landmark the gate's innovation covariance S comes from.
 enum class GateCovariance {
   /// Their joint marginal: a gather from P (EKF), one multi-column solve with the factor of Omega
@@ -306,16 +323,12 @@ inline double reobservation_noise_scale(double feature_scale, double nis, const 
 }  // namespace detail
 
 /// Associates the frame's features with the predicted landmarks; new landmarks take ids
-/// next_id, next_id + 1, ... (next_id is advanced).
+/// next_id, next_id + 1, ... (next_id is advanced). Bad options throw invalid_input_error
+/// (require_valid) before next_id changes.
 inline FrameAssociation associate_to_map(const StereoFrame& frame, std::span<const PredictedLandmark> predicted,
                                          const LandmarkAppearance& appearance, LandmarkId& next_id,
                                          const MapAssociationOptions& o) {
-  if (!(o.new_landmark_density >= 0.0))
-    throw invalid_input_error("map association: new_landmark_density " + std::to_string(o.new_landmark_density) +
-                              " per m^3 must be >= 0");
-  if (!(o.student_t_dof >= 0.0) || !std::isfinite(o.student_t_dof))
-    throw invalid_input_error("map association: student_t_dof " + std::to_string(o.student_t_dof) +
-                              " must be >= 0 and finite (0: Gaussian re-observations)");
+  require_valid(o);
   std::vector<bool> gated;
   const auto pair_of = detail::one_to_one(detail::gated_descriptor_matches(frame, predicted, appearance, o, gated),
                                           frame.features.size(), predicted.size());

@@ -196,6 +196,7 @@ inline std::size_t associate_returning(const StereoFrame& frame, std::span<const
   if (frames_unseen.size() != predicted.size())
     throw invalid_input_error("returning landmarks: " + std::to_string(frames_unseen.size()) + " ages for " +
                               std::to_string(predicted.size()) + " predicted landmarks");
+  require_valid(o);
   require_valid(r);
   std::vector<bool> feature_taken(frame.features.size(), false);
   std::vector<LandmarkId> taken_ids;

@@ -75,7 +75,7 @@ class StereoTracker {
         width_(width), height_(height), options_(options) {
     auto& max_distance = options_.association.max_descriptor_distance;
     if (!max_distance) max_distance = default_max_descriptor_distance(options.front_end.detector.detector);
-    (void)descriptor_distance_bound(options_.association);  // refused before any frame, not in one
+    require_valid(options_.association);  // refused before any frame, not in one
     if (options.returning.after_frames > 0) require_valid(options.returning);
   }
 
