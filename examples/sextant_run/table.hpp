@@ -71,7 +71,7 @@ inline void print_skipped_steps(int indent, std::size_t count, const char* unit,
 inline void print_relocalization(int indent, const RelocalizationRow& r) {
   std::printf("%-*s relocalized at %.0f of %.0f steps; %.0f landmarks linked to the robot at the end (at most %.0f%s)\n",
               indent, "", r.relocalizations, r.steps, r.active, r.max_active,
-              r.active > r.max_active ? " when a held-back set carries enough information" : "");
+              r.active > r.max_active ? " when that many of a step's landmarks carry enough information about the robot" : "");
 }
 
 /// The pose ANEES, or "collapsed" where some steps' covariance rests on too few particles to be one

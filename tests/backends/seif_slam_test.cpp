@@ -231,6 +231,34 @@ TEST(SeifSlam, RelocalizationHoldsBackTheLandmarksTheMapKnowsNotOneSeenOnce) {
   EXPECT_EQ(std::set<LandmarkId>(active.begin(), active.end()), (std::set<LandmarkId>{1, 2}));
 }
 
+/// When the max_active most informative measurements do not carry relocalization_min_information of
+/// the robot's information given the map, the next most informative are held back with them until
+/// they do. Before, the step did not sparsify, the robot stayed linked to every landmark it saw, its
+/// information given the map grew with them, and no later step could relocalize either (a log of
+/// MRPT's simulator seeing 68 landmarks a step never sparsified; docs/results/seif_relocalization.md).
+TEST(SeifSlam, RelocalizationHoldsBackMoreThanMaxActiveWhenTheyDoNotCarryEnough) {
+  const BeaconShip2D motion;
+  const BeaconOffset2D sensor;
+  constexpr std::size_t kSeen = 6, kMaxActive = 2;
+  Seif seif{motion, sensor, test::kLinearPrior,
+            {.max_active = kMaxActive, .sparsification = SeifSparsification::relocalization,
+             .relocalization_min_information = 0.5}};
+  std::vector<Observation<Eigen::Vector2d>> frame;
+  for (std::size_t i = 0; i < kSeen; ++i)
+    frame.push_back({i + 1, Eigen::Vector2d(std::cos(double(i)), std::sin(double(i))) * (3.0 + double(i))});
+  const auto step = [&] {
+    seif.predict(Eigen::Vector2d::Zero(), 3.0);  // at rest, its position uncertain by ~2 a step (the
+    seif.update(frame);                          // measurements' sigma): the odometry carries little
+  };
+  step();  // every landmark new: nothing to relocalize from
+  step();  // two carry at most ~2/6 of the robot's information given the map
+  ASSERT_EQ(seif.relocalizations(), 1u);
+  EXPECT_GT(seif.active_landmarks().size(), kMaxActive);
+  EXPECT_LT(seif.active_landmarks().size(), kSeen);  // no more than needed
+  for (int k = 0; k < 4; ++k) step();
+  EXPECT_EQ(seif.relocalizations(), 5u);  // and the active set never grows to every landmark again
+}
+
 TEST(SeifSlam, TheExactMeanEstimateIsTheMeanAnExactRecoveryMovesTo) {
   const auto data = sim::simulate_ship_2d({.seed = 3, .num_steps = 200});
   for (auto sparsification : {SeifSparsification::thesis, SeifSparsification::relocalization}) {

@@ -71,8 +71,9 @@ struct SeifOptions {
   SeifSparsification sparsification = SeifSparsification::thesis;
   /// Relocalization only: the held-back measurements, their landmarks' uncertainty counted, must
   /// carry at least this share of the robot's information given the map (Omega_xx) in every
-  /// direction, else the step does not sparsify and the active set stays over max_active until one
-  /// can. A pose relocalized from two landmarks 0.2 m apart seen from 5 m has a heading the next
+  /// direction: when max_active of them do not, the next most informative join them (the new active
+  /// set is then larger than max_active); when all of the step's do not, the step does not sparsify
+  /// and the active set stays over max_active until one can. A pose relocalized from two landmarks 0.2 m apart seen from 5 m has a heading the next
   /// linearizations cannot trust; the sweep that chose 0.05 (at most 20x less information, 4.5x the
   /// standard deviation) is in docs/results/seif_relocalization.md.
   double relocalization_min_information = 0.05;
@@ -312,8 +313,9 @@ class SeifSlam {
   auto mark_slots(const std::vector<std::size_t>& slots);
   void update_active_queue(const std::vector<std::size_t>& observed_slots);
   /// ESEIF: the observations to relocalize the robot from, taken out of `observations`, when the
-  /// update would leave more than max_active landmarks linked to the robot and some of them
-  /// determine the robot state (else none: the active set overflows until a step can relocalize).
+  /// update would leave more than max_active landmarks linked to the robot: max_active of them, or
+  /// as many more as carry relocalization_min_information (none when all of them do not: the active
+  /// set then overflows until a step can relocalize).
   std::vector<MeasurementInformation> hold_back_for_relocalization(std::vector<MeasurementInformation>& observations,
                                                                    std::size_t new_landmarks) const;
   std::vector<Eigen::Matrix<double, X, X>> information_about_robot(const std::vector<MeasurementInformation>& observations) const;
@@ -321,6 +323,11 @@ class SeifSlam {
   static constexpr int kUnseenTail = conditionally_linear_dims_v<Motion>;
   Eigen::MatrixXd relocalized_tail_information(const PoseEstimate& prior) const;
   std::optional<Eigen::Matrix<double, X - kUnseenTail, X - kUnseenTail>> seen_information_given_map() const;
+  static void pick_most_informative(std::vector<MeasurementInformation>& observations,
+                                    std::vector<Eigen::Matrix<double, X, X>>& about_robot, std::size_t k,
+                                    Eigen::Matrix<double, X, X>& chosen);
+  bool carries_enough(const Eigen::Matrix<double, X, X>& chosen,
+                      const Eigen::Matrix<double, X - kUnseenTail, X - kUnseenTail>& reference) const;
   /// Omega' = Omega_mm - Omega_mx Omega_xx^-1 Omega_xm and r' likewise, over the active landmarks
   /// only; leaves the robot with no information and no links.
   void marginalize_robot();

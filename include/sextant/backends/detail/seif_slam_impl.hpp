@@ -599,11 +599,12 @@ void SeifSlam<Motion, Sensor>::recover_mean_exactly_in_transaction() {
   info_.set_residual(r - omega * delta);
 }
 
-/// Which observed landmarks relocalize the robot (ESEIF): up to max_active of them (the new active
-/// set), chosen greedily for the most information about the robot (largest log det of Lambda, the
-/// sum of information_about_robot, D-optimal), provided Lambda holds at least
-/// relocalization_min_information of the robot's information Omega_xx in every direction (the
-/// robot state is determined by them alone, well enough to stay where linearization holds). As
+/// Which observed landmarks relocalize the robot (ESEIF): max_active of them (the new active set),
+/// chosen greedily for the most information about the robot (largest log det of Lambda, the sum of
+/// information_about_robot, D-optimal), and more, the next most informative, until Lambda holds at
+/// least relocalization_min_information of the robot's information Omega_xx in every direction (the
+/// robot state is determined by them alone, well enough to stay where linearization holds); none
+/// when all of the step's measurements do not. As
 /// many as the active set holds, the most informative first: a relocalized pose from the fewest
 /// that determine it (two range-bearing landmarks) tracked at 6x the EKF's error on kf-slam_demo,
 /// from eight in the order observed at 1.7x, from the eight most informative at 1.3x, and 1.16x
@@ -621,34 +622,54 @@ auto SeifSlam<Motion, Sensor>::hold_back_for_relocalization(std::vector<Measurem
   std::vector<MatrixX> about_robot = information_about_robot(observations);
   MatrixX total = MatrixX::Zero();
   for (const auto& lambda : about_robot) total += lambda;
-  const auto count = std::min(observations.size(), options_.max_active);
-  MatrixX chosen = 1e-12 * total.trace() / X * MatrixX::Identity();  // log det defined from the first pick
-  for (std::size_t k = 0; k < count; ++k) {
-    std::size_t best = k;
-    double best_log_det = -std::numeric_limits<double>::infinity();
-    for (std::size_t j = k; j < observations.size(); ++j) {
-      const double log_det = (chosen + about_robot[j]).ldlt().vectorD().array().log().sum();
-      if (log_det > best_log_det) best_log_det = log_det, best = j;
-    }
-    std::swap(observations[k], observations[best]);
-    std::swap(about_robot[k], about_robot[best]);
-    chosen += about_robot[k];
-  }
   // Lambda_beta v = lambda Omega_ss v on the entries measurements see (s): the share of the robot's
   // information given the map that the held-back measurements carry, where they carry least.
-  constexpr int P = X - kUnseenTail;
-  using MatrixP = Eigen::Matrix<double, P, P>;
-  const MatrixP seen = chosen.template topLeftCorner<P, P>();
   const auto reference = seen_information_given_map();
   if (!reference) return {};
-  const Eigen::GeneralizedSelfAdjointEigenSolver<MatrixP> relative(seen, *reference, Eigen::EigenvaluesOnly);
-  if (!(relative.eigenvalues()(0) >= options_.relocalization_min_information)) return {};
-  const Eigen::SelfAdjointEigenSolver<MatrixP> eigen(seen, Eigen::EigenvaluesOnly);
-  if (!(eigen.eigenvalues()(0) > 1e-9 * eigen.eigenvalues()(P - 1))) return {};
+  const MatrixX floor = 1e-12 * total.trace() / X * MatrixX::Identity();  // log det defined from the first pick
+  if (!carries_enough(total + floor, *reference)) return {};  // then no subset does: information only adds
+  MatrixX chosen = floor;
+  std::size_t count = 0;
+  for (; count < observations.size(); ++count) {
+    if (count >= options_.max_active && carries_enough(chosen, *reference)) break;
+    pick_most_informative(observations, about_robot, count, chosen);
+  }
+  if (!carries_enough(chosen, *reference)) return {};  // all of them, summed in another order
   const auto held_end = observations.begin() + static_cast<std::ptrdiff_t>(count);
   std::vector<MeasurementInformation> held(std::make_move_iterator(observations.begin()), std::make_move_iterator(held_end));
   observations.erase(observations.begin(), held_end);
   return held;
+}
+
+/// Moves the observation (from position k on) whose information about the robot adds most to
+/// log det(chosen) to position k, and adds its information to chosen.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::pick_most_informative(std::vector<MeasurementInformation>& observations,
+                                                     std::vector<Eigen::Matrix<double, X, X>>& about_robot, std::size_t k,
+                                                     Eigen::Matrix<double, X, X>& chosen) {
+  std::size_t best = k;
+  double best_log_det = -std::numeric_limits<double>::infinity();
+  for (std::size_t j = k; j < observations.size(); ++j) {
+    const double log_det = (chosen + about_robot[j]).ldlt().vectorD().array().log().sum();
+    if (log_det > best_log_det) best_log_det = log_det, best = j;
+  }
+  std::swap(observations[k], observations[best]);
+  std::swap(about_robot[k], about_robot[best]);
+  chosen += about_robot[k];
+}
+
+/// Whether the information `chosen` about the robot holds relocalization_min_information of
+/// `reference` (the robot's seen entries given the map) in every direction, and is well conditioned.
+template <class Motion, class Sensor>
+bool SeifSlam<Motion, Sensor>::carries_enough(const Eigen::Matrix<double, X, X>& chosen,
+                                              const Eigen::Matrix<double, X - kUnseenTail, X - kUnseenTail>& reference) const {
+  constexpr int P = X - kUnseenTail;
+  using MatrixP = Eigen::Matrix<double, P, P>;
+  const MatrixP seen = chosen.template topLeftCorner<P, P>();
+  const Eigen::GeneralizedSelfAdjointEigenSolver<MatrixP> relative(seen, reference, Eigen::EigenvaluesOnly);
+  if (!(relative.eigenvalues()(0) >= options_.relocalization_min_information)) return false;
+  const Eigen::SelfAdjointEigenSolver<MatrixP> eigen(seen, Eigen::EigenvaluesOnly);
+  return eigen.eigenvalues()(0) > 1e-9 * eigen.eigenvalues()(P - 1);
 }
 
 /// What each observation tells about the robot once its landmark's uncertainty is counted: the
