@@ -73,9 +73,10 @@ struct SeifOptions {
   /// carry at least this share of the robot's information given the map (Omega_xx) in every
   /// direction: when max_active of them do not, the next most informative join them (the new active
   /// set is then larger than max_active); when all of the step's do not, the step does not sparsify
-  /// and the active set stays over max_active until one can. A pose relocalized from two landmarks 0.2 m apart seen from 5 m has a heading the next
-  /// linearizations cannot trust; the sweep that chose 0.05 (at most 20x less information, 4.5x the
-  /// standard deviation) is in docs/results/seif_relocalization.md.
+  /// and the active set stays over max_active until one can. A pose relocalized from two landmarks
+  /// 0.2 m apart seen from 5 m has a heading the next linearizations cannot trust; the sweep that
+  /// chose 0.05 (at most 20x less information, 4.5x the standard deviation) is in
+  /// docs/results/seif_relocalization.md.
   double relocalization_min_information = 0.05;
   /// Relocalization of a robot whose motion model has a tail no measurement sees
   /// (kConditionallyLinearDims = T, e.g. the 12D camera's velocities): the covariance (T x T) the

@@ -626,9 +626,9 @@ auto SeifSlam<Motion, Sensor>::hold_back_for_relocalization(std::vector<Measurem
   // information given the map that the held-back measurements carry, where they carry least.
   const auto reference = seen_information_given_map();
   if (!reference) return {};
-  const MatrixX floor = 1e-12 * total.trace() / X * MatrixX::Identity();  // log det defined from the first pick
-  if (!carries_enough(total + floor, *reference)) return {};  // then no subset does: information only adds
-  MatrixX chosen = floor;
+  const MatrixX regularizer = 1e-12 * total.trace() / X * MatrixX::Identity();  // log det defined from the first pick
+  if (!carries_enough(total + regularizer, *reference)) return {};  // then no subset does: information only adds
+  MatrixX chosen = regularizer;
   std::size_t count = 0;
   for (; count < observations.size(); ++count) {
     if (count >= options_.max_active && carries_enough(chosen, *reference)) break;
