@@ -251,6 +251,13 @@ inline double creation_blocking_nis(const Eigen::Matrix3d& S_inverse, double gat
   return std::min(gate, -2.0 * std::log(density) - log_det_S - 3.0 * std::log(2.0 * std::acos(-1.0)));
 }
 
+/// Whether the nearest descriptor is kept as a pair: within max_distance, and clearly the nearest
+/// (Lowe's test against the second) unless ratio >= 1 turns the test off.
+template <class Payload>
+bool keeps_descriptor_match(const NearestTwo<Payload>& n, double max_distance, double ratio) {
+  return n.best <= max_distance && (ratio >= 1.0 || n.clearly_nearest(ratio));
+}
+
 /// Per feature, its nearest landmark descriptor among the landmarks whose gate it is inside, kept
 /// when within max_descriptor_distance and the ratio test against the second nearest; `gated[i]`:
 /// feature i is inside some gate. Each landmark tests only the features within its gate's reach
@@ -292,7 +299,7 @@ inline std::vector<FeaturePair> gated_descriptor_matches(const StereoFrame& fram
   }
   std::vector<FeaturePair> pairs;
   for (const auto& n : nearest)
-    if (n.best <= max_distance && (o.ratio >= 1.0 || n.clearly_nearest(o.ratio))) pairs.push_back(n.nearest);
+    if (keeps_descriptor_match(n, max_distance, o.ratio)) pairs.push_back(n.nearest);
   return pairs;
 }
 

@@ -84,7 +84,7 @@ inline std::vector<ReturningPair> returning_descriptor_pairs(const StereoFrame& 
     for (const std::size_t i : free_features)
       if ((frame.features[i].point - predicted[j].z).squaredNorm() <= reach * reach)
         nearest.offer(descriptor_distance(frame.descriptors, static_cast<int>(i), *descriptor, 0), i);
-    if (nearest.best <= max_distance && (o.ratio >= 1.0 || nearest.clearly_nearest(o.ratio)))
+    if (keeps_descriptor_match(nearest, max_distance, o.ratio))
       pairs.push_back({j, nearest.nearest, static_cast<int>(nearest.best)});
   }
   std::stable_sort(pairs.begin(), pairs.end(), [](const auto& a, const auto& b) { return a.distance < b.distance; });
