@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <numbers>
 #include <random>
 
+#include "sextant/core/gaussian.hpp"
 #include "sextant/core/pose3_euler_space.hpp"
 #include "sextant/core/se2_space.hpp"
 #include "sextant/core/se3_space.hpp"
@@ -109,6 +111,36 @@ TEST(StateSpaceJacobians, GroupSpacesDifferFromTheAdditiveFallback) {
   static_assert(has_plus_jacobian_v<Se3Space, Eigen::Matrix4d> && has_plus_jacobian_v<Se2WorldSpace, Eigen::Vector3d>);
   static_assert(!has_plus_jacobian_v<Se2Space, Eigen::Vector3d> && !has_plus_jacobian_v<EuclideanSpace<2>, Eigen::Vector2d>);
   static_assert(has_minus_jacobians_v<Se3Space, Eigen::Matrix4d> && !has_minus_jacobians_v<Se2Space, Eigen::Vector3d>);
+}
+
+/// Past 90° of pitch the Euler chart names a rotation a second way; canonical() gives the one
+/// ypr_from_rotation gives, and its Jacobian carries a covariance along.
+TEST(Pose3EulerSpace, CanonicalNamesTheSameRotationWithPitchWithinNinetyDegrees) {
+  using Space = Pose3EulerSpace;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi);
+  for (int i = 0; i < 200; ++i) {
+    Space::Point x;
+    x << 1.0, -2.0, 0.5, angle(rng), angle(rng), angle(rng);
+    const Space::Point c = Space::canonical(x);
+    EXPECT_LE(std::abs(c(4)), std::numbers::pi / 2);
+    EXPECT_TRUE(c.head<3>() == x.head<3>());
+    EXPECT_LT((rotation_of<double>(c) - rotation_of<double>(x)).norm(), 1e-12) << x.transpose();
+    EXPECT_TRUE(Space::canonical(c) == c);
+    if (std::abs(std::abs(x(4)) - std::numbers::pi / 2) < 0.1) continue;  // a step e must not cross the border
+    const Space::Tangent e = 1e-6 * (Space::Tangent() << 1, 2, 3, -2, 1.5, 0.7).finished();
+    const Space::Tangent through_jacobian =
+        Space::minus(Space::plus(c, Space::canonical_jacobian(x) * e), Space::canonical(Space::plus(x, e)));
+    EXPECT_LT(through_jacobian.norm(), 1e-12) << x.transpose();
+  }
+  Gaussian<Space::Point, 6> flipped{(Space::Point() << 0, 0, 0, 0.2, 2.0, -0.3).finished(), Eigen::Matrix<double, 6, 6>::Identity()};
+  flipped.cov(4, 3) = flipped.cov(3, 4) = 0.5;
+  const auto canonical = in_canonical_coordinates<Space>(flipped);
+  EXPECT_NEAR(canonical.mean(4), std::numbers::pi - 2.0, 1e-15);
+  EXPECT_EQ(canonical.cov(4, 3), -0.5);
+  EXPECT_EQ(canonical.cov(4, 4), 1.0);
+  const auto planar = in_canonical_coordinates<Se2Space>(Gaussian<Eigen::Vector3d, 3>{Eigen::Vector3d(0, 0, 3.0), Eigen::Matrix3d::Identity()});
+  EXPECT_EQ(planar.mean(2), 3.0);  // one name per point: unchanged
 }
 
 }  // namespace

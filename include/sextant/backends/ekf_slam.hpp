@@ -119,7 +119,10 @@ class EkfSlam {
   /// Throws invalid_input_error on a d that is not finite; the state is then unchanged.
   void reacquire_pose(const Eigen::Matrix<double, X, 1>& d);
 
-  PoseEstimate pose() const { return {x_, symmetric_diagonal_block<X>(cov_.view(), 0)}; }
+  /// In its space's canonical coordinates (in_canonical_coordinates: an update can carry a pitch past 90°).
+  PoseEstimate pose() const {
+    return in_canonical_coordinates<Space>(PoseEstimate{x_, symmetric_diagonal_block<X>(cov_.view(), 0)});
+  }
   LandmarkEstimate<M> landmark(LandmarkId id) const { return landmark_at(landmarks_.slot(id)); }
   MapEstimate map() const;
   /// Every landmark's id and mean, O(n): map() without its covariances (what a front-end needs to

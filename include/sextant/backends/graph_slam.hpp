@@ -131,7 +131,8 @@ class GraphSlam {
   /// recorded since the last optimize() do not shrink it. trajectory() gives exact marginals.
   /// Online mode: after each update() the mean is the step's estimate and the covariance the newest
   /// pose's marginal in the linearized system (one block of the incremental factor).
-  PoseEstimate pose() const { return {poses_.back(), newest_cov_}; }
+  /// Every pose estimate is given in its space's canonical coordinates (in_canonical_coordinates).
+  PoseEstimate pose() const { return in_canonical_coordinates<Space>(PoseEstimate{poses_.back(), newest_cov_}); }
   /// Every pose x_0 .. x_K with its marginal covariance.
   std::vector<PoseEstimate> trajectory() const;
   LandmarkEstimate<M> landmark(LandmarkId id) const;

@@ -7,6 +7,7 @@
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/observation.hpp"
+#include "sextant/core/state_space.hpp"
 
 /// Inside a back-end class template with parameters named Motion and Sensor: State, Control, Space,
 /// Landmark, Measurement, ObservationType, the dimensions X (pose), M (landmark), Z (measurement),

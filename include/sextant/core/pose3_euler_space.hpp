@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <numbers>
 
 #include "sextant/core/autodiff.hpp"
 
@@ -88,6 +89,33 @@ struct Pose3EulerSpace {
   }
   static Tangent minus(const Point& a, const Point& b) { return euler_difference<double>(a, b); }
   static bool is_finite(const Point& x) { return x.allFinite(); }
+
+  /// The pose with its rotation named as ypr_from_rotation names it, pitch in [-pi/2, pi/2]:
+  /// (yaw + pi, +-pi - pitch, roll + pi) is the same rotation, and a step of this additive chart (a
+  /// Gauss-Newton step, a filter's update) can carry pitch past pi/2, where minus() would see a turn
+  /// of ~pi that is not there (docs/results/simul_landmarks.md, "A robot that pitches past 90°").
+  static Point canonical(const Point& x) {
+    if (!flips_to_canonical(x)) return x;
+    constexpr double pi = std::numbers::pi;
+    const double pitch = wrap_angle_generic(x(4));
+    Point out = x;
+    out(3) = wrap_angle_generic(x(3) + pi);
+    out(4) = (pitch > 0.0 ? pi : -pi) - pitch;
+    out(5) = wrap_angle_generic(x(5) + pi);
+    return out;
+  }
+  /// J with canonical(plus(x, e)) = plus(canonical(x), J e) to first order: pitch's sign flips
+  /// where canonical() renames the rotation.
+  static Eigen::Matrix<double, 6, 6> canonical_jacobian(const Point& x) {
+    Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Identity();
+    if (flips_to_canonical(x)) J(4, 4) = -1.0;
+    return J;
+  }
+
+ private:
+  static bool flips_to_canonical(const Point& x) {
+    return std::abs(wrap_angle_generic(x(4))) > std::numbers::pi / 2;
+  }
 };
 
 }  // namespace sextant

@@ -70,6 +70,19 @@ TangentJacobian<Space, Point> plus_jacobian(const Point& x, const Tangent& d) {
     return TangentJacobian<Space, Point>::Identity();
 }
 
+/// An estimate (mean, cov) with its mean in its space's canonical coordinates and its covariance
+/// carried along (J cov J^T): a space whose chart names one point several ways defines canonical()
+/// and canonical_jacobian() (Pose3EulerSpace); any other space's estimate is returned as it is.
+template <class Space, class Estimate>
+Estimate in_canonical_coordinates(Estimate estimate) {
+  if constexpr (requires { Space::canonical(estimate.mean); }) {
+    const auto J = Space::canonical_jacobian(estimate.mean);
+    estimate.mean = Space::canonical(estimate.mean);
+    estimate.cov = (J * estimate.cov * J.transpose()).eval();
+  }
+  return estimate;
+}
+
 /// Whether minus_jacobian_first<Space> can differ from the identity (the space defines it).
 template <class Space, class Point>
 inline constexpr bool has_minus_jacobians_v = requires(const Point& a) { Space::minus_jacobian_first(a, a); };

@@ -649,7 +649,8 @@ auto GraphSlam<Motion, Sensor>::trajectory() const -> std::vector<PoseEstimate> 
   const auto marginals = this->marginals();
   std::vector<PoseEstimate> out;
   out.reserve(poses_.size());
-  for (std::size_t p = 0; p < poses_.size(); ++p) out.push_back({poses_[p], marginals->block(X * p, X)});
+  for (std::size_t p = 0; p < poses_.size(); ++p)
+    out.push_back(in_canonical_coordinates<Space>(PoseEstimate{poses_[p], marginals->block(X * p, X)}));
   return out;
 }
 

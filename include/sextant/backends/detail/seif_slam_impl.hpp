@@ -935,7 +935,7 @@ auto SeifSlam<Motion, Sensor>::conditional_joints(std::span<const LandmarkId> id
 
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::pose() const -> PoseEstimate {
-  return {estimated_pose_mean(), marginal_covariance(0, X)};
+  return in_canonical_coordinates<Space>(PoseEstimate{estimated_pose_mean(), marginal_covariance(0, X)});
 }
 
 template <class Motion, class Sensor>
