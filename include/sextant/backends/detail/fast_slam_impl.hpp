@@ -521,10 +521,11 @@ std::size_t FastSlam<Motion, Sensor, Map>::best_particle(const std::vector<Parti
                                   particles.begin());
 }
 
-/// The weighted mixture of the particles' pose Gaussians, in the tangent space at the best particle.
+/// The weighted mixture of the particles' pose Gaussians, in the tangent space at the best particle,
+/// given in the space's canonical coordinates (in_canonical_coordinates).
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::pose() const -> PoseEstimate {
-  return estimate_ ? *estimate_ : cloud_estimate(particles_, pending_);
+  return in_canonical_coordinates<Space>(estimate_ ? *estimate_ : cloud_estimate(particles_, pending_));
 }
 
 template <class Motion, class Sensor, template <class> class Map>
