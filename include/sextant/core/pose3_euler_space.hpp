@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "sextant/core/autodiff.hpp"
+#include "sextant/core/state_space.hpp"
 
 namespace sextant {
 
@@ -95,26 +96,19 @@ struct Pose3EulerSpace {
   /// Gauss-Newton step, a filter's update) can carry pitch past pi/2, where minus() would see a turn
   /// of ~pi that is not there (docs/results/simul_landmarks.md, "A robot that pitches past 90°").
   static Point canonical(const Point& x) {
-    if (!flips_to_canonical(x)) return x;
-    constexpr double pi = std::numbers::pi;
-    const double pitch = wrap_angle_generic(x(4));
+    if (!euler_middle_angle_past_right_angle(x(4))) return x;
     Point out = x;
-    out(3) = wrap_angle_generic(x(3) + pi);
-    out(4) = (pitch > 0.0 ? pi : -pi) - pitch;
-    out(5) = wrap_angle_generic(x(5) + pi);
+    out(3) = wrap_angle_generic(x(3) + std::numbers::pi);
+    out(4) = mirrored_euler_middle_angle(x(4));
+    out(5) = wrap_angle_generic(x(5) + std::numbers::pi);
     return out;
   }
   /// J with canonical(plus(x, e)) = plus(canonical(x), J e) to first order: pitch's sign flips
   /// where canonical() renames the rotation.
   static Eigen::Matrix<double, 6, 6> canonical_jacobian(const Point& x) {
     Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Identity();
-    if (flips_to_canonical(x)) J(4, 4) = -1.0;
+    if (euler_middle_angle_past_right_angle(x(4))) J(4, 4) = -1.0;
     return J;
-  }
-
- private:
-  static bool flips_to_canonical(const Point& x) {
-    return std::abs(wrap_angle_generic(x(4))) > std::numbers::pi / 2;
   }
 };
 

@@ -18,6 +18,16 @@ inline double wrap_angle(double angle) {
   return wrapped - std::numbers::pi;
 }
 
+/// Euler angles name every rotation twice: with the middle angle b of the sequence past pi/2 (after
+/// wrapping), (a + pi, +-pi - b, c + pi) is the same rotation, and that name has b within
+/// [-pi/2, pi/2] (MRPT's yaw-pitch-roll, Pose3EulerSpace; the globe camera's yxz angles, euler_yxz).
+inline bool euler_middle_angle_past_right_angle(double b) { return std::abs(wrap_angle(b)) > std::numbers::pi / 2; }
+/// The middle angle of the other name, +-pi - b with b wrapped (see euler_middle_angle_past_right_angle).
+inline double mirrored_euler_middle_angle(double b) {
+  const double wrapped = wrap_angle(b);
+  return (wrapped > 0.0 ? std::numbers::pi : -std::numbers::pi) - wrapped;
+}
+
 /// Euclidean R^N: plus is +, minus is -.
 template <int N>
 struct EuclideanSpace {

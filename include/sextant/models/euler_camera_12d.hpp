@@ -85,14 +85,13 @@ inline Eigen::Matrix3d rate_derivative(const Eigen::Vector3d& eta, const Eigen::
 
 /// Whether canonical() mirrors phi (|phi| past pi/2 after wrapping): then d canonical / d eta is
 /// diag(-1, 1, 1), which a Jacobian through canonical() must apply.
-inline bool mirrors_phi(const Eigen::Vector3d& eta) { return std::abs(wrap_angle(eta(0))) > std::numbers::pi / 2; }
+inline bool mirrors_phi(const Eigen::Vector3d& eta) { return euler_middle_angle_past_right_angle(eta(0)); }
 
 /// The same rotation with phi in [-pi/2, pi/2] and theta, psi in (-pi, pi]: (phi, theta, psi) and
 /// (pi - phi, theta + pi, psi + pi) give the same R.
 inline Eigen::Vector3d canonical(Eigen::Vector3d eta) {
   if (mirrors_phi(eta)) {
-    const double phi = wrap_angle(eta(0));
-    eta(0) = (phi > 0 ? std::numbers::pi : -std::numbers::pi) - phi;
+    eta(0) = mirrored_euler_middle_angle(eta(0));
     eta(1) += std::numbers::pi;
     eta(2) += std::numbers::pi;
   }
