@@ -38,7 +38,7 @@ struct BackendRun {
 inline bool associates(BackendKind kind) { return kind != BackendKind::graph; }
 
 inline AssociationRow association_row(const eval::AssociationScore& a) {
-  return {a.precision(), a.recall(), a.wrong(), a.duplicates(), a.discarded()};
+  return {a.precision(), a.recall(), a.wrong(), a.duplicates(), a.discarded(), a.searches_cut()};
 }
 
 /// Whether `kind` sits this data set out because the ids are withheld and it cannot associate.

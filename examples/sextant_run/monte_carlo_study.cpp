@@ -14,7 +14,8 @@ std::vector<std::pair<std::string, double>> association_extras(const Association
           {"association_recall", a.recall},
           {"association_wrong", static_cast<double>(a.wrong)},
           {"association_duplicates", static_cast<double>(a.duplicates)},
-          {"association_discarded", static_cast<double>(a.discarded)}};
+          {"association_discarded", static_cast<double>(a.discarded)},
+          {"association_searches_cut", static_cast<double>(a.searches_cut)}};
 }
 
 std::vector<std::pair<std::string, double>> cloud_extras(const CloudRow& cloud) {
@@ -51,7 +52,8 @@ std::optional<AssociationRow> association_of(const eval::StudyRecord& r) {
   if (!has_extra(r, "association_precision")) return std::nullopt;
   return AssociationRow{r.extra("association_precision"), r.extra("association_recall"), static_cast<std::size_t>(r.extra("association_wrong")),
                         static_cast<std::size_t>(r.extra("association_duplicates")),
-                        static_cast<std::size_t>(r.extra("association_discarded"))};
+                        static_cast<std::size_t>(r.extra("association_discarded")),
+                        has_extra(r, "association_searches_cut") ? static_cast<std::size_t>(r.extra("association_searches_cut")) : 0};
 }
 
 /// The row of one cell's runs (records[begin, end), in seed order).

@@ -568,6 +568,10 @@ inline std::vector<ConfigKey> association_keys() {
      "a measurement outside every landmark's gate at this probability starts a new landmark; inside one but unpaired "
      "it is discarded",
      [](RunnerConfig& c, const std::string& v) { c.association.options.new_landmark_probability = parse_probability(v); }},
+    {"association", "max_nodes", "20000",
+     "JCBB: search nodes a step may visit before it settles for the best hypothesis found so far (the table counts "
+     "the steps where it did)",
+     [](RunnerConfig& c, const std::string& v) { c.association.options.max_nodes = parse_integer<std::size_t>(v, 1); }},
   };
 }
 

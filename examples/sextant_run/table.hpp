@@ -92,7 +92,8 @@ inline void print_row(const TableRow& row) {
               anees_cell(s).c_str(), s.total_seconds, 1e6 * s.seconds_per_step);
   if (const auto& a = row.association)
     std::printf("%-29s association: precision %.4f, recall %.4f; %zu wrong pairings, %zu duplicate landmarks, %zu "
-                "discarded\n", "", a->precision, a->recall, a->wrong, a->duplicates, a->discarded);
+                "discarded%s\n", "", a->precision, a->recall, a->wrong, a->duplicates, a->discarded,
+                a->searches_cut == 0 ? "" : ("; JCBB cut at its node limit at " + std::to_string(a->searches_cut) + " steps").c_str());
   if (const auto& cloud = row.cloud)
     std::printf("%-29s the cloud at the end: N_eff %.3g of %.0f; all descend from %.0f of the %.0f it started with\n", "",
                 cloud->effective_sample_size, cloud->particles, cloud->distinct_ancestors, cloud->particles);

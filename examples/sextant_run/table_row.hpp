@@ -52,6 +52,7 @@ constexpr Scoring scoring_of() {
 struct AssociationRow {
   double precision, recall;
   std::size_t wrong, duplicates, discarded;
+  std::size_t searches_cut = 0;  ///< JCBB searches stopped at [association] max_nodes
 };
 
 /// A particle filter's cloud at the end of a run (FastSLAM): what its NEES columns rest on.

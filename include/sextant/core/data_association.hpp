@@ -41,8 +41,9 @@ struct AssociationOptions {
   /// A measurement compatible with no landmark at this (stricter) probability starts a new
   /// landmark; one compatible at it but left unpaired is discarded as ambiguous.
   double new_landmark_probability = 0.9999;
-  /// JCBB nodes visited before the search settles for the best hypothesis found so far.
-  std::size_t max_nodes = 200000;
+  /// JCBB nodes visited before the search settles for the best hypothesis found so far (a node
+  /// costs O(k²) for k pairings: ~6 µs at 60; docs/data_association.md, "A search that finishes").
+  std::size_t max_nodes = 20000;
 };
 
 /// What one measurement became.
@@ -172,6 +173,7 @@ class DataAssociation {
         : owner_(owner), joint_(joint), pairs_(pairs), measurements_(measurements), first_(measurements + 1, 0) {
       for (const Pair& p : pairs_) ++first_[p.measurement + 1];
       for (std::size_t i = 0; i < measurements; ++i) first_[i + 1] += first_[i];
+      order_ = fewest_candidates_first();
       for (std::size_t k = 1; k <= measurements; ++k)
         joint_gate_.push_back(chi_square_quantile(static_cast<double>(Z * k), owner.options_.gate_probability));
     }
@@ -199,7 +201,12 @@ class DataAssociation {
       taken_.assign(joint_.ids.size(), false);
       nodes_ = 0;
       complete_ = true;
-      descend(0, 0);
+      stack_.clear();
+      const Eigen::Index rows = Z * static_cast<Eigen::Index>(std::min(measurements_, joint_.ids.size()));
+      factor_.resize(rows, rows);
+      whitened_.resize(rows);
+      cross_.resize(rows, Z);
+      descend(0, 0.0);
       return best_;
     }
 
@@ -208,16 +215,18 @@ class DataAssociation {
     bool complete() const { return complete_; }
 
    private:
-    /// JCBB (Neira & Tardós 2001, Fig. 2): measurement i pairs with each compatible free landmark in
-    /// turn while the hypothesis stays jointly compatible, then stays unpaired if that can still
-    /// match the best hypothesis's number of pairings.
-    void descend(std::size_t i, std::size_t pairings) const {
+    /// JCBB (Neira & Tardós 2001, Fig. 2): the i-th measurement of order_ pairs with each compatible
+    /// free landmark in turn while the hypothesis stays jointly compatible, then stays unpaired if
+    /// that can still match the best hypothesis's number of pairings. `nis` is the joint NIS of the
+    /// pairings made so far; a branch that can at most tie the best's pairings is cut once its NIS
+    /// is no smaller than the best's (a pairing only adds to the joint NIS): the result is the same.
+    void descend(std::size_t i, double nis) const {
       if (++nodes_ > owner_.options_.max_nodes) {
         complete_ = false;
         return;
       }
+      const std::size_t pairings = stack_.size();
       if (i == measurements_) {
-        const double nis = nis_of(hypothesis_).value_or(0.0);
         if (pairings > best_pairings_ || (pairings == best_pairings_ && pairings > 0 && nis < best_nis_)) {
           best_ = hypothesis_;
           best_pairings_ = pairings;
@@ -226,24 +235,60 @@ class DataAssociation {
         return;
       }
       const std::size_t remaining = measurements_ - i - 1;
-      if (pairings + 1 + remaining >= best_pairings_)
-        for (std::size_t k = first_[i]; k < first_[i + 1]; ++k) {
+      if (can_still_win(pairings + 1 + remaining, nis))
+        for (std::size_t k = first_[order_[i]]; k < first_[order_[i] + 1]; ++k) {
           const Pair& p = pairs_[k];
           if (p.nis > owner_.individual_gate_ || taken_[p.landmark]) continue;
-          hypothesis_[i] = static_cast<int>(k);
-          if (jointly_compatible(pairings + 1)) {
-            taken_[p.landmark] = true;
-            descend(i + 1, pairings + 1);
-            taken_[p.landmark] = false;
-          }
-          hypothesis_[i] = -1;
+          const std::optional<double> joint = nis_with(p, nis);
+          if (!joint || *joint > joint_gate_[pairings] || !can_still_win(pairings + 1 + remaining, *joint)) continue;
+          hypothesis_[p.measurement] = static_cast<int>(k);
+          taken_[p.landmark] = true;
+          stack_.push_back(&p);
+          descend(i + 1, *joint);
+          stack_.pop_back();
+          taken_[p.landmark] = false;
+          hypothesis_[p.measurement] = -1;
         }
-      if (pairings + remaining >= best_pairings_) descend(i + 1, pairings);
+      if (can_still_win(pairings + remaining, nis)) descend(i + 1, nis);
     }
 
-    bool jointly_compatible(std::size_t pairings) const {
-      const auto nis = nis_of(hypothesis_);
-      return nis && *nis <= joint_gate_[pairings - 1];
+    /// The order the search takes the measurements in: fewest individually compatible landmarks
+    /// first, ties in input order (the most constrained first, as in any constraint search), so the
+    /// ambiguous ones come last, when the pairings before them have pinned the robot and the best
+    /// hypothesis's NIS leaves their alternatives little room.
+    std::vector<std::size_t> fewest_candidates_first() const {
+      std::vector<std::size_t> candidates(measurements_, 0), order(measurements_);
+      for (const Pair& p : pairs_)
+        if (p.nis <= owner_.individual_gate_) ++candidates[p.measurement];
+      for (std::size_t i = 0; i < measurements_; ++i) order[i] = i;
+      std::stable_sort(order.begin(), order.end(),
+                       [&](std::size_t a, std::size_t b) { return candidates[a] < candidates[b]; });
+      return order;
+    }
+
+    /// Whether a branch that can reach at most `pairings` pairings, with joint NIS `nis` so far, can
+    /// still beat the best hypothesis: more pairings, or as many with a smaller NIS.
+    bool can_still_win(std::size_t pairings, double nis) const {
+      return pairings > best_pairings_ || (pairings == best_pairings_ && (pairings == 0 || nis < best_nis_));
+    }
+
+    /// The joint NIS of the stacked pairings and p, by extending the Cholesky factor of their S by
+    /// p's rows (O(k²) for k pairings, instead of factoring S anew); none when S is not positive
+    /// definite. Writes p's rows of the factor and of the whitened innovation, which stay valid
+    /// while p is on the stack.
+    std::optional<double> nis_with(const Pair& p, double nis) const {
+      const Eigen::Index n = Z * static_cast<Eigen::Index>(stack_.size());
+      auto cross = cross_.topRows(n);  // S(stack, p), then C^T with C = S(p, stack) L^-T
+      for (std::size_t a = 0; a < stack_.size(); ++a)
+        cross.template middleRows<Z>(Z * static_cast<Eigen::Index>(a)) = innovation_block(joint_, *stack_[a], p);
+      factor_.topLeftCorner(n, n).template triangularView<Eigen::Lower>().solveInPlace(cross);
+      const Eigen::LLT<Eigen::Matrix<double, Z, Z>> tail(innovation_block(joint_, p, p) - cross.transpose() * cross);
+      if (tail.info() != Eigen::Success) return std::nullopt;
+      const Eigen::Matrix<double, Z, 1> y = tail.matrixL().solve(p.residual - cross.transpose() * whitened_.head(n));
+      factor_.block(n, 0, Z, n) = cross.transpose();
+      factor_.block(n, n, Z, Z) = tail.matrixL();
+      whitened_.template segment<Z>(n) = y;
+      return nis + y.squaredNorm();
     }
 
     /// The joint NIS of the pairings in `chosen`, none when their S is not positive definite.
@@ -273,9 +318,14 @@ class DataAssociation {
     const std::vector<Pair>& pairs_;
     std::size_t measurements_;
     std::vector<std::size_t> first_;  ///< pairs_[first_[i], first_[i+1]) belong to measurement i
+    std::vector<std::size_t> order_;  ///< the measurements in the order the search takes them
     std::vector<double> joint_gate_;  ///< chi-square quantile for 1, 2, ... pairings
     mutable std::vector<int> hypothesis_, best_;
     mutable std::vector<bool> taken_;
+    mutable std::vector<const Pair*> stack_;  ///< the hypothesis's pairings, in the order made
+    mutable Eigen::MatrixXd factor_;          ///< lower Cholesky factor of the stacked pairings' S
+    mutable Eigen::VectorXd whitened_;        ///< factor^-1 times their stacked innovations
+    mutable Eigen::Matrix<double, Eigen::Dynamic, Z> cross_;  ///< workspace of nis_with
     mutable std::size_t best_pairings_ = 0, nodes_ = 0;
     mutable double best_nis_ = 0.0;
     mutable bool complete_ = true;

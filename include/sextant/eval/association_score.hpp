@@ -48,6 +48,7 @@ class AssociationScore {
       }
     }
     mapped_.insert(created_now.begin(), created_now.end());
+    if (!result.search_complete) ++searches_cut_;
   }
 
   /// The true id of a landmark the association created, none for one it did not.
@@ -65,11 +66,13 @@ class AssociationScore {
   /// New landmarks made for a true landmark already in the map.
   std::size_t duplicates() const { return duplicates_; }
   std::size_t discarded() const { return discarded_; }
+  /// Steps whose JCBB search stopped at its node limit with the best hypothesis found so far.
+  std::size_t searches_cut() const { return searches_cut_; }
 
  private:
   std::unordered_map<LandmarkId, LandmarkId> truth_of_;  ///< created landmark -> true id
   std::unordered_set<LandmarkId> mapped_;                 ///< true ids with a landmark in the map
-  std::size_t correct_ = 0, wrong_ = 0, duplicates_ = 0, discarded_ = 0, should_pair_ = 0;
+  std::size_t correct_ = 0, wrong_ = 0, duplicates_ = 0, discarded_ = 0, should_pair_ = 0, searches_cut_ = 0;
 };
 
 }  // namespace sextant::eval

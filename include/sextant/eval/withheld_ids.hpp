@@ -38,7 +38,6 @@ class WithheldIds {
     const auto result = association_.associate(backend_, std::span<const Measurement>(z));
     const UpdateResult update = backend_.update(result.observations);
     score_.record(std::span<const LandmarkId>(truth), result);
-    if (!result.search_complete) ++incomplete_searches_;
     return update;
   }
   UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }
@@ -54,14 +53,11 @@ class WithheldIds {
   void remove_landmark(LandmarkId id) { backend_.remove_landmark(id); }
 
   const AssociationScore& score() const { return score_; }
-  /// Steps where JCBB stopped at its node limit with the best hypothesis found so far.
-  std::size_t incomplete_searches() const { return incomplete_searches_; }
 
  private:
   Backend& backend_;
   DataAssociation<Sensor> association_;
   AssociationScore score_;
-  std::size_t incomplete_searches_ = 0;
 };
 
 }  // namespace sextant::eval
