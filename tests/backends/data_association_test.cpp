@@ -3,6 +3,7 @@
 // thesis's ship with its ids withheld, scored against the run that knows them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -93,8 +94,9 @@ TEST(DataAssociation, FarMeasurementStartsALandmarkAndASecondClaimOnOneLandmarkI
 }
 
 /// Every hypothesis JCBB may choose, by enumeration: each measurement unpaired or paired with a
-/// distinct landmark inside the individual gate, every prefix of its pairings (in measurement order)
-/// inside the joint gate; the most pairings win, then the smallest joint NIS. Returns the ids chosen
+/// distinct landmark inside the individual gate, every prefix of its pairings inside the joint gate,
+/// prefixes taken in the search's order (fewest individually compatible landmarks first, ties in
+/// input order); the most pairings win, then the smallest joint NIS. Returns the ids chosen
 /// (0 = unpaired) and that NIS, each NIS from a fresh factorization of the stacked S.
 std::pair<std::vector<LandmarkId>, double> best_by_enumeration(const PointInRobotFrame2D& sensor, const Joint& joint,
                                                                const std::vector<Eigen::Vector2d>& z) {
@@ -121,11 +123,18 @@ std::pair<std::vector<LandmarkId>, double> best_by_enumeration(const PointInRobo
     if (llt.info() != Eigen::Success) return std::nullopt;
     return llt.matrixL().solve(nu).squaredNorm();
   };
+  auto compatible = [&](std::size_t i, std::size_t j) { return *nis_of({{i, j}}) <= chi_square_quantile(2, 0.99); };
+  std::vector<std::size_t> candidates(m, 0), order(m);
+  for (std::size_t i = 0; i < m; ++i) {
+    order[i] = i;
+    for (std::size_t j = 0; j < n; ++j) candidates[i] += compatible(i, j);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return candidates[a] < candidates[b]; });
   std::vector<std::pair<std::size_t, std::size_t>> pairs, best;
   double best_nis = 0.0;
   std::vector<bool> taken(n, false);
-  std::function<void(std::size_t)> visit = [&](std::size_t i) {
-    if (i == m) {
+  std::function<void(std::size_t)> visit = [&](std::size_t position) {
+    if (position == m) {
       const double nis = nis_of(pairs).value_or(0.0);
       if (pairs.size() > best.size() || (pairs.size() == best.size() && !pairs.empty() && nis < best_nis)) {
         best = pairs;
@@ -133,18 +142,19 @@ std::pair<std::vector<LandmarkId>, double> best_by_enumeration(const PointInRobo
       }
       return;
     }
+    const std::size_t i = order[position];
     for (std::size_t j = 0; j < n; ++j) {
-      if (taken[j] || *nis_of({{i, j}}) > chi_square_quantile(2, 0.99)) continue;
+      if (taken[j] || !compatible(i, j)) continue;
       pairs.emplace_back(i, j);
       const auto nis = nis_of(pairs);
       if (nis && *nis <= chi_square_quantile(2.0 * static_cast<double>(pairs.size()), 0.99)) {
         taken[j] = true;
-        visit(i + 1);
+        visit(position + 1);
         taken[j] = false;
       }
       pairs.pop_back();
     }
-    visit(i + 1);
+    visit(position + 1);
   };
   visit(0);
   std::vector<LandmarkId> ids(m, 0);
