@@ -114,7 +114,8 @@ std::vector<TableRow> run_on_rawlog(const std::string& name, const Dataset& data
     if (data.ids == io::LandmarkIds::absent && !c.association.method)
       throw invalid_input_error(name + ": its landmarks have no ids: run it with --associate nn|jcbb");
     if (data.ids == io::LandmarkIds::from_ground_truth)
-      std::printf("%s: the log has no landmark ids; each measurement took the id of its nearest true landmark, %s\n",
+      std::printf("%s: the log has no landmark ids; each frame's measurements took the ids of the distinct true landmarks "
+                  "that explain them best from the true pose, %s\n",
                   name.c_str(), c.association.method ? "which scores the association" : "an oracle association");
   }
   for (const auto& choice : backend_choices<std::decay_t<decltype(Dataset::motion)>>(kinds, c)) {

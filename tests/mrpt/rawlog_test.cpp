@@ -363,6 +363,28 @@ TEST_F(WrittenRawlog, LandmarksWithoutIdsTakeTheirIdsFromTheGroundTruth) {
   EXPECT_EQ(data.steps[0].observations[1].landmark_id, 9u);
   EXPECT_EQ(data.steps[1].observations[0].landmark_id, 9u);
   EXPECT_LT(inferred->worst_nis, 1e-6);  // measurements written exactly (floats)
+  EXPECT_EQ(inferred->resolved_jointly, 0u);
+  // One frame, two sightings nearest to landmark 7 each on its own: one exactly at it, one 0.4 m
+  // towards 9. A sensor sees a landmark once a frame, so the second is 9's (the least total NIS).
+  const float between = static_cast<float>(std::hypot(3.0, 0.4));
+  const auto competing = write("competing.rawlog", false, action(1.0, 0.0, 0.0),
+                               frame(two(3.0f, 0.0f, between, std::atan2(0.4f, 3.0f))));
+  auto both = read_rawlog_2d(competing);
+  const auto resolved = attach_ground_truth(both, {map, robot_path});
+  ASSERT_TRUE(resolved);
+  EXPECT_EQ(both.steps[0].observations[0].landmark_id, 7u);
+  EXPECT_EQ(both.steps[0].observations[1].landmark_id, 9u);
+  EXPECT_EQ(resolved->resolved_jointly, 1u);
+  // Three sightings in a frame of a two-landmark world: one landmark was seen twice.
+  auto three = two(3.0f, 0.0f, between, std::atan2(0.4f, 3.0f));
+  three->sensedData.push_back(obs(far, std::atan2(1.0f, 3.0f))->sensedData[0]);
+  auto crowded = read_rawlog_2d(write("crowded.rawlog", false, action(1.0, 0.0, 0.0), frame(three)));
+  try {
+    attach_ground_truth(crowded, {map, robot_path});
+    ADD_FAILURE() << "three sightings took ids from two landmarks";
+  } catch (const invalid_input_error& e) {
+    EXPECT_NE(std::string(e.what()).find("step 0: more observations than true landmarks"), std::string::npos) << e.what();
+  }
   // A log with ids is left as it is.
   const auto with_ids = write("ids.rawlog", false, action(1.0, 0.0, 0.0), frame(bearing({{7, 3.0f}})));
   auto known = read_rawlog_2d(with_ids);

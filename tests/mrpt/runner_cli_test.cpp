@@ -423,8 +423,8 @@ TEST_F(RunnerCli, RawlogWithoutIdsRunsEveryBackEndThatAssociates) {
   const auto r =
       run_runner("-d " + sextant::testing::mrpt_demo("kf-slam_6D_demo_DA.rawlog") + " -b ekf,graph,fastslam2 --associate jcbb", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("the log has no landmark ids; each measurement took the id of its nearest true landmark, which "
-                       "scores the association"),
+  EXPECT_NE(r.out.find("the log has no landmark ids; each frame's measurements took the ids of the distinct true "
+                       "landmarks that explain them best from the true pose, which scores the association"),
             std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("graph needs known ids, left out"), std::string::npos) << r.out;
