@@ -38,6 +38,10 @@ TEST(Metrics, AbsoluteErrorNeesMaeRmse) {
   EXPECT_DOUBLE_EQ(rms(errors), std::sqrt(4.5));
   EXPECT_DOUBLE_EQ(fraction_at_most(errors, 2.0), 0.75);
   EXPECT_EQ(mean({}), 0.0);
+  EXPECT_TRUE(std::isnan(mean_or_nan({})) && std::isnan(rms_or_nan({})) && std::isnan(fraction_at_most_or_nan({}, 1.0)));
+  EXPECT_DOUBLE_EQ(mean_or_nan(errors), 2.0);
+  EXPECT_DOUBLE_EQ(rms_or_nan(errors), std::sqrt(4.5));
+  EXPECT_DOUBLE_EQ(fraction_at_most_or_nan(errors, 2.0), 0.75);
 }
 
 TEST(Metrics, AneesPerStepAveragesRuns) {

@@ -134,6 +134,24 @@ TEST(RunScores, AStepWhosePoseRestsOnTooFewParticlesIsUndersampledAndNeverInside
   EXPECT_TRUE(std::isnan(scores_of(r, 2, 2).pose_anees_supported));
 }
 
+TEST(RunScores, ARunWithNothingToScoreScoresNoneNotZero) {
+  // A back-end whose every step failed (GraphSLAM on exact odometry): no pose after the start, no
+  // map. Zeros would read as a perfect run; every score is NaN, which the table prints as "-".
+  RunSummary<Eigen::Vector2d> r;
+  r.seconds.assign(4, 1e-3);
+  for (std::size_t k = 0; k < 4; ++k) r.failures.record(k, true, numerical_error("singular"));
+  const auto s = scores_of(r, 2, 2);
+  for (double score : {s.pose_mae, s.pose_rmse, s.pose_rmse_aligned, s.pose_mae_aligned, s.map_mae, s.map_mae_over_time,
+                       s.map_mae_aligned, s.pose_nees_inside, s.map_nees_inside, s.pose_anees, s.pose_undersampled,
+                       s.pose_anees_supported})
+    EXPECT_TRUE(std::isnan(score)) << score;
+  EXPECT_EQ(s.failed_steps, 4u);
+  const auto average = summarize(std::vector{s, s}, 2);
+  EXPECT_TRUE(std::isnan(average.pose_mae) && std::isnan(average.map_mae) && std::isnan(average.pose_anees));
+  EXPECT_FALSE(average.anees_interval);
+  EXPECT_EQ(average.failed_steps, 8u);
+}
+
 TEST(StudyRecords, MergedShardsAverageToTheBitLikeTheRunsInOneProcess) {
   std::mt19937_64 rng(7);
   std::vector<RunSummary<Eigen::Vector2d>> runs;

@@ -68,7 +68,7 @@ CameraScores score_camera(const std::vector<Pose>& means, const std::vector<Samp
 }
 
 /// Averages of one run's scores, as the thesis's Tables 8-9 give them, with the share of NEES
-/// values inside the one-sided 95% bound (7.81 for 3 dof); NaN where no NEES was computed.
+/// values inside the one-sided 95% bound (7.81 for 3 dof); NaN where there is nothing to score.
 struct CameraSummary {
   double position_mae = 0, rotation_mae = 0, map_mae = 0, position_mae_aligned = 0, map_mae_aligned = 0;
   double position_anees = 0, rotation_anees = 0;
@@ -77,19 +77,17 @@ struct CameraSummary {
 
 inline CameraSummary summarize_camera(const CameraScores& s, double confidence = 0.95) {
   CameraSummary out;
-  out.position_mae = mean(s.position_error);
-  out.rotation_mae = mean(s.rotation_error);
-  out.map_mae = mean(s.map_error);
-  out.position_mae_aligned = mean(s.position_error_aligned);
-  out.map_mae_aligned = mean(s.map_error_aligned);
+  out.position_mae = mean_or_nan(s.position_error);
+  out.rotation_mae = mean_or_nan(s.rotation_error);
+  out.map_mae = mean_or_nan(s.map_error);
+  out.position_mae_aligned = mean_or_nan(s.position_error_aligned);
+  out.map_mae_aligned = mean_or_nan(s.map_error_aligned);
   const double bound = nees_upper_bound(3, confidence);
-  auto average = [](const std::vector<double>& v) { return v.empty() ? std::nan("") : mean(v); };
-  auto inside = [&](const std::vector<double>& v) { return v.empty() ? std::nan("") : fraction_at_most(v, bound); };
-  out.position_anees = average(s.position_nees);
-  out.rotation_anees = average(s.rotation_nees);
-  out.position_nees_inside = inside(s.position_nees);
-  out.rotation_nees_inside = inside(s.rotation_nees);
-  out.map_nees_inside = inside(s.map_nees);
+  out.position_anees = mean_or_nan(s.position_nees);
+  out.rotation_anees = mean_or_nan(s.rotation_nees);
+  out.position_nees_inside = fraction_at_most_or_nan(s.position_nees, bound);
+  out.rotation_nees_inside = fraction_at_most_or_nan(s.rotation_nees, bound);
+  out.map_nees_inside = fraction_at_most_or_nan(s.map_nees, bound);
   return out;
 }
 

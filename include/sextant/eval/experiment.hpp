@@ -185,15 +185,15 @@ template <class State>
 RunScores scores_of(const RunSummary<State>& r, int pose_dof, int landmark_dof, double confidence = 0.95) {
   RunScores s;
   s.steps = r.seconds.size();
-  s.pose_mae = mean(r.pose_error);
-  s.pose_rmse = rms(r.pose_error);
-  s.pose_rmse_aligned = rms(r.pose_error_aligned);
-  s.pose_mae_aligned = mean(r.pose_error_aligned);
-  s.map_mae = mean(r.map_error);
-  s.map_mae_over_time = r.map_error_over_time;
-  s.map_mae_aligned = mean(r.map_error_aligned);
+  s.pose_mae = mean_or_nan(r.pose_error);
+  s.pose_rmse = rms_or_nan(r.pose_error);
+  s.pose_rmse_aligned = rms_or_nan(r.pose_error_aligned);
+  s.pose_mae_aligned = mean_or_nan(r.pose_error_aligned);
+  s.map_mae = mean_or_nan(r.map_error);
+  s.map_mae_over_time = r.map_error.empty() ? std::numeric_limits<double>::quiet_NaN() : r.map_error_over_time;
+  s.map_mae_aligned = mean_or_nan(r.map_error_aligned);
   add_pose_consistency(s, r.pose_nees, r.pose_support, pose_dof, confidence);
-  s.map_nees_inside = fraction_at_most(r.map_nees, nees_upper_bound(landmark_dof, confidence));
+  s.map_nees_inside = fraction_at_most_or_nan(r.map_nees, nees_upper_bound(landmark_dof, confidence));
   s.total_seconds = r.total_seconds;
   s.failed_steps = r.failures.total();
   s.first_failure = r.failures.first;

@@ -5,8 +5,8 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <span>
 #include <string>
@@ -60,6 +60,18 @@ inline double fraction_at_most(std::span<const double> values, double bound) {
   if (values.empty()) return 0.0;
   const auto inside = std::count_if(values.begin(), values.end(), [bound](double v) { return v <= bound; });
   return static_cast<double>(inside) / static_cast<double>(values.size());
+}
+
+/// A score over no values is none: NaN (a table prints "-"), not the 0 of an empty mean(), which
+/// would read as a perfect score (e.g. a back-end whose every step failed).
+inline double mean_or_nan(std::span<const double> values) {
+  return values.empty() ? std::numeric_limits<double>::quiet_NaN() : mean(values);
+}
+inline double rms_or_nan(std::span<const double> values) {
+  return values.empty() ? std::numeric_limits<double>::quiet_NaN() : rms(values);
+}
+inline double fraction_at_most_or_nan(std::span<const double> values, double bound) {
+  return values.empty() ? std::numeric_limits<double>::quiet_NaN() : fraction_at_most(values, bound);
 }
 
 /// One-sided upper bound of NEES for `dof` degrees of freedom at `confidence`

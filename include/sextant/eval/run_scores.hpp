@@ -67,6 +67,10 @@ struct Summary {
 /// count as inside; the average over the other steps beside the average over all.
 inline void add_pose_consistency(RunScores& s, const std::vector<double>& nees, const std::vector<double>& support,
                                  int pose_dof, double confidence) {
+  if (nees.empty()) {  // no step to score (e.g. every one failed)
+    s.pose_nees_inside = s.pose_undersampled = s.pose_anees = s.pose_anees_supported = std::numeric_limits<double>::quiet_NaN();
+    return;
+  }
   const double bound = nees_upper_bound(pose_dof, confidence);
   std::size_t inside = 0, undersampled = 0;
   double supported_sum = 0.0;
@@ -76,7 +80,7 @@ inline void add_pose_consistency(RunScores& s, const std::vector<double>& nees, 
     inside += !sampled_too_thinly && nees[k] <= bound;
     if (!sampled_too_thinly) supported_sum += nees[k];
   }
-  const double steps = static_cast<double>(std::max<std::size_t>(1, nees.size()));
+  const double steps = static_cast<double>(nees.size());
   s.pose_nees_inside = static_cast<double>(inside) / steps;
   s.pose_undersampled = static_cast<double>(undersampled) / steps;
   s.pose_anees = mean(nees);
