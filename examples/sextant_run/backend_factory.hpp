@@ -55,6 +55,15 @@ inline SeifEstimate use_estimate(const std::optional<SeifEstimate>& choice, Seif
   return sparsification == SeifSparsification::relocalization ? SeifEstimate::exact_mean : SeifEstimate::recovered_mean;
 }
 
+/// SeifOptions::stale_mean_probability (RunnerConfig::seif_stale_mean_probability): `auto` (nullopt)
+/// means 0.999 with relocalization, which after a loop closure would otherwise linearize at a map
+/// left behind (docs/results/seif_relocalization.md, "A map left behind by a loop closure"), and 0
+/// (never) with the thesis's sparsification, whose Table 5 stays reproduced.
+inline double use_stale_mean_probability(const std::optional<double>& choice, SeifSparsification sparsification) {
+  if (choice) return *choice;
+  return sparsification == SeifSparsification::relocalization ? 0.999 : 0.0;
+}
+
 /// One choice per kind, as the config sets it: the first-estimate policy for Motion's chart,
 /// FastSLAM's version and eseif's relocalization from the kind. When [seif] sparsification is
 /// relocalization, seif is ESEIF already and eseif is left out (a row once).
@@ -72,20 +81,26 @@ std::vector<BackendChoice> backend_choices(const std::vector<BackendKind>& kinds
     choice.ekf.observability_constraints = use_observability_constraints<Motion>(c.ekf_observability_constraints);
     choice.seif.observability_constraints = use_observability_constraints<Motion>(c.seif_observability_constraints);
     choice.seif.estimate = use_estimate(c.seif_estimate, choice.seif.sparsification);
+    choice.seif.stale_mean_probability = use_stale_mean_probability(c.seif_stale_mean_probability, choice.seif.sparsification);
     choice.fastslam.version = kind == BackendKind::fastslam1 ? FastSlamVersion::v1 : FastSlamVersion::v2;
     choices.push_back(std::move(choice));
   }
   return choices;
 }
 
-/// An ESEIF run's relocalizations after `steps` steps (the line below its row); none for the others.
+/// A SEIF run's relocalizations (ESEIF) and exact recoveries of a stale mean after `steps` steps (the
+/// line below its row); none for the other back-ends and for a SEIF that does neither.
 template <class Backend>
 std::optional<RelocalizationRow> relocalization_row(const Backend& backend, std::size_t steps) {
-  if constexpr (requires { backend.relocalizations(); })
-    if (backend.options().sparsification == SeifSparsification::relocalization)
+  if constexpr (requires { backend.relocalizations(); }) {
+    const auto& o = backend.options();
+    const bool relocalizes = o.sparsification == SeifSparsification::relocalization;
+    if (relocalizes || o.stale_mean_probability > 0.0)
       return RelocalizationRow{static_cast<double>(steps), static_cast<double>(backend.relocalizations()),
-                               static_cast<double>(backend.active_landmarks().size()),
-                               static_cast<double>(backend.options().max_active)};
+                               static_cast<double>(backend.active_landmarks().size()), static_cast<double>(o.max_active),
+                               relocalizes,
+                               o.stale_mean_probability > 0.0 ? static_cast<double>(backend.stale_recoveries()) : -1.0};
+  }
   return std::nullopt;
 }
 

@@ -28,7 +28,9 @@ std::vector<std::pair<std::string, double>> relocalization_extras(const Relocali
   return {{"relocalization_steps", r.steps},
           {"relocalizations", r.relocalizations},
           {"relocalization_active", r.active},
-          {"relocalization_max_active", r.max_active}};
+          {"relocalization_max_active", r.max_active},
+          {"relocalization_relocalizes", r.relocalizes ? 1.0 : 0.0},
+          {"stale_recoveries", r.stale_recoveries}};
 }
 
 namespace {
@@ -44,8 +46,11 @@ std::optional<CloudRow> cloud_of(const eval::StudyRecord& r) {
 
 std::optional<RelocalizationRow> relocalization_of(const eval::StudyRecord& r) {
   if (!has_extra(r, "relocalizations")) return std::nullopt;
-  return RelocalizationRow{r.extra("relocalization_steps"), r.extra("relocalizations"), r.extra("relocalization_active"),
-                           r.extra("relocalization_max_active")};
+  RelocalizationRow row{r.extra("relocalization_steps"), r.extra("relocalizations"), r.extra("relocalization_active"),
+                        r.extra("relocalization_max_active")};
+  if (has_extra(r, "relocalization_relocalizes")) row.relocalizes = r.extra("relocalization_relocalizes") != 0.0;
+  if (has_extra(r, "stale_recoveries")) row.stale_recoveries = r.extra("stale_recoveries");
+  return row;
 }
 
 std::optional<AssociationRow> association_of(const eval::StudyRecord& r) {

@@ -128,6 +128,7 @@ struct RunnerConfig {
   AutoSwitch seif_observability_constraints = AutoSwitch::automatic;
   SeifOptions seif{.max_active = 8};
   std::optional<SeifEstimate> seif_estimate;              ///< nullopt: auto (backend_factory.hpp)
+  std::optional<double> seif_stale_mean_probability;      ///< nullopt: auto (backend_factory.hpp)
   GraphOptions graph;
   PoseGraphOptions pose_graph;
   PoseGraphStart pose_graph_start = PoseGraphStart::file;
@@ -664,6 +665,14 @@ inline std::vector<ConfigKey> seif_keys() {
      [](RunnerConfig& c, const std::string& v) { c.seif.mean_recovery_sweeps = parse_integer<int>(v, 0, 1e4); }},
     {"seif", "exact_recovery_period", "0", "every K updates an exact solve of the whole mean; 0 = never",
      [](RunnerConfig& c, const std::string& v) { c.seif.exact_recovery_period = parse_integer<int>(v, 0); }},
+    {"seif", "stale_mean_probability", "auto",
+     "the whole mean recovered exactly (one sparse solve) in a step after which a landmark next to the recovered "
+     "block would move, given its neighbours, beyond the chi-square quantile at this probability of its "
+     "conditional information, as after a loop closure; auto (0.999 with relocalization, 0 with the thesis's "
+     "sparsification) | 0 = never | p",
+     [](RunnerConfig& c, const std::string& v) {
+       c.seif_stale_mean_probability = v == "auto" ? std::nullopt : std::optional(parse_gate_probability(v));
+     }},
   };
 }
 

@@ -67,11 +67,17 @@ inline void print_skipped_steps(int indent, std::size_t count, const char* unit,
               count == 1 ? "" : "s", first.c_str());
 }
 
-/// The line below an ESEIF row: how often it relocalized, how many landmarks stay linked to the robot.
+/// The line below an ESEIF row: how often it relocalized, how many landmarks stay linked to the robot;
+/// below any SEIF row that recovered its whole mean for staleness ([seif] stale_mean_probability), how often.
 inline void print_relocalization(int indent, const RelocalizationRow& r) {
-  std::printf("%-*s relocalized at %.0f of %.0f steps; %.0f landmarks linked to the robot at the end (at most %.0f%s)\n",
-              indent, "", r.relocalizations, r.steps, r.active, r.max_active,
-              r.active > r.max_active ? " when that many of a step's landmarks carry enough information about the robot" : "");
+  if (r.relocalizes)
+    std::printf("%-*s relocalized at %.0f of %.0f steps; %.0f landmarks linked to the robot at the end (at most %.0f%s)\n",
+                indent, "", r.relocalizations, r.steps, r.active, r.max_active,
+                r.active > r.max_active ? " when that many of a step's landmarks carry enough information about the robot" : "");
+  if (r.stale_recoveries > 0.0)
+    std::printf("%-*s the whole mean recovered exactly at %.0f of %.0f steps, where the map beside the active block "
+                "lagged (stale_mean_probability)\n",
+                indent, "", r.stale_recoveries, r.steps);
 }
 
 /// The pose ANEES, or "collapsed" where some steps' covariance rests on too few particles to be one
@@ -151,8 +157,11 @@ inline void write_summary_json(const std::string& path, const std::vector<TableR
     if (const auto& a = rows[i].association)
       out << ", \"association_precision\": " << json_number(a->precision)
           << ", \"association_recall\": " << json_number(a->recall);
-    if (const auto& r = rows[i].relocalization)
-      out << ", \"relocalizations\": " << json_number(r->relocalizations) << ", \"active_at_end\": " << json_number(r->active);
+    if (const auto& r = rows[i].relocalization) {
+      if (r->relocalizes)
+        out << ", \"relocalizations\": " << json_number(r->relocalizations) << ", \"active_at_end\": " << json_number(r->active);
+      if (r->stale_recoveries >= 0.0) out << ", \"stale_recoveries\": " << json_number(r->stale_recoveries);
+    }
     out << "}" << (i + 1 < rows.size() ? ",\n" : "\n");
   }
   out << "]\n";

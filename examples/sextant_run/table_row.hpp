@@ -60,11 +60,14 @@ struct CloudRow {
   double particles, effective_sample_size, distinct_ancestors;
 };
 
-/// An ESEIF run at its end (SeifSparsification::relocalization): how often it relocalized and how
-/// many landmarks stay linked to the robot. A run that never relocalizes is an exact SEIF at the
-/// cost of one whose active set grows (docs/results/seif_relocalization.md).
+/// A SEIF run at its end. ESEIF (SeifSparsification::relocalization): how often it relocalized and
+/// how many landmarks stay linked to the robot; a run that never relocalizes is an exact SEIF at the
+/// cost of one whose active set grows (docs/results/seif_relocalization.md). With
+/// SeifOptions::stale_mean_probability, in how many steps the whole mean was recovered exactly.
 struct RelocalizationRow {
   double steps, relocalizations, active, max_active;
+  bool relocalizes = true;
+  double stale_recoveries = -1.0;  ///< -1: stale_mean_probability off
 };
 
 /// A line of the comparison table.

@@ -91,6 +91,13 @@ struct SeifOptions {
   MeanRecovery mean_recovery = MeanRecovery::active_block;
   int mean_recovery_sweeps = 1;   ///< sweeps per update (0 = none)
   int exact_recovery_period = 0;  ///< every K updates, an exact sparse solve of the whole mean; 0 = never
+  /// In (0, 1): the local recovery moves the block's means and leaves the rest of the map where it
+  /// was, so after a loop closure the landmarks next to the block lag behind and later steps linearize
+  /// at them. When one of the landmarks whose residual r_p the recovery changed would move, given its
+  /// neighbours, by more than the chi-square quantile at this probability of its conditional
+  /// information (r_p^T Omega_pp^-1 r_p), the whole mean is recovered exactly (one sparse solve, only
+  /// in such steps). 0 = never (the thesis's SEIF).
+  double stale_mean_probability = 0.0;
   /// In (0, 1): reject observations whose innovation fails the chi-square test at this probability
   /// (core/innovation_gate.hpp), with S from the exact joint marginal of the robot and the landmark.
   /// That costs one sparse factorization of Omega per update: with the gate on, an update is no
@@ -208,6 +215,9 @@ class SeifSlam {
   const SeifUpdateTimes& last_update_times() const { return last_update_times_; }
   /// Updates that relocalized the robot (SeifSparsification::relocalization) since construction.
   std::uint64_t relocalizations() const { return relocalizations_; }
+  /// Updates whose whole mean was recovered exactly because the map next to the block lagged
+  /// (SeifOptions::stale_mean_probability) since construction.
+  std::uint64_t stale_recoveries() const { return stale_recoveries_; }
 
  private:
   using Linearized = LinearizedObservation<Z, X, M>;
@@ -305,6 +315,11 @@ class SeifSlam {
   std::vector<Eigen::Index> unlinked_positions(const std::vector<std::size_t>& slots, std::size_t leading) const;
   void apply_mean_recovery(const std::vector<std::size_t>& slots, const Eigen::VectorXd& delta,
                            const Eigen::VectorXd& r_after);
+  /// Remembers, once per recovery, a landmark outside the block whose residual it changed.
+  void note_changed_residual(std::size_t slot);
+  /// SeifOptions::stale_mean_probability: the whole mean recovered exactly when a landmark noted by
+  /// note_changed_residual lags its neighbours by more than the gate.
+  void recover_exactly_if_stale();
   void robot_and_landmarks_block(const std::vector<std::size_t>& slots, Eigen::Ref<Eigen::MatrixXd> D) const;
   void gather_links_below(const std::vector<std::size_t>& slots, std::size_t a, Eigen::Ref<Eigen::MatrixXd> D,
                           std::size_t first) const;
@@ -364,6 +379,9 @@ class SeifSlam {
   std::vector<std::size_t> active_queue_;  ///< slots linked to the robot, most recently observed first
   std::uint64_t updates_ = 0;
   std::uint64_t relocalizations_ = 0;
+  std::uint64_t stale_recoveries_ = 0;
+  double stale_gate_ = 0.0;  ///< chi-square quantile of SeifOptions::stale_mean_probability (0: off)
+  bool recovered_stale_mean_ = false;  ///< this update recovered the whole mean for staleness (scratch)
   std::uint64_t revision_ = 0;
   Undo* undo_ = nullptr;  ///< the open transaction's undo record
   VersionedCache<Factor> factor_;  ///< factorization of Omega at revision_ (thread-safe)
@@ -372,6 +390,9 @@ class SeifSlam {
   SquareWorkspace factor_workspace_;  ///< its Cholesky factor (scratch)
   std::vector<std::uint64_t> slot_marks_;  ///< mark_slots' marks, per slot (scratch)
   std::uint64_t last_mark_ = 0;
+  std::vector<std::size_t> changed_residuals_;  ///< note_changed_residual's landmarks (scratch)
+  std::vector<std::uint64_t> changed_marks_;     ///< their marks, per slot (scratch)
+  std::uint64_t last_changed_mark_ = 0;
 };
 
 }  // namespace sextant

@@ -32,6 +32,9 @@ SeifSlam<Motion, Sensor>::SeifSlam(Motion motion, Sensor sensor, const PoseEstim
   if (options_.iterations < 1)
     throw invalid_input_error("SeifOptions: iterations must be >= 1 (1 = one linearization, the thesis's SEIF)");
   gate_ = InnovationGate(Z, options_.gate_probability);
+  if (!(options_.stale_mean_probability >= 0.0 && options_.stale_mean_probability < 1.0))
+    throw invalid_input_error("SeifOptions: stale_mean_probability must be in [0, 1) (0 = off)");
+  if (options_.stale_mean_probability > 0.0) stale_gate_ = chi_square_quantile(M, options_.stale_mean_probability);
   if (options_.sparsification == SeifSparsification::relocalization) tail_information_ = relocalized_tail_information(prior);
 }
 
@@ -228,6 +231,9 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
     if (auto landmark = new_landmark(observation, result.unusable)) landmarks.push_back(std::move(*landmark));
   result.initialized = landmarks.size();
   auto relocalization = hold_back_for_relocalization(measurements, fresh.size());
+  recovered_stale_mean_ = false;
+  changed_residuals_.clear();
+  ++last_changed_mark_;
 
   atomically([&] {
     const State prior = x_;
@@ -252,14 +258,19 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
   });
   last_update_times_ = times;
   if (!relocalization.empty()) ++relocalizations_;
+  if (recovered_stale_mean_) ++stale_recoveries_;
   return result;
 }
 
 template <class Motion, class Sensor>
 std::optional<Eigen::VectorXd> SeifSlam<Motion, Sensor>::recover_step_mean() {
-  if (!exact_recovery_due()) return recover_mean_locally();
-  recover_mean_exactly_in_transaction();
-  return std::nullopt;
+  if (exact_recovery_due()) {
+    recover_mean_exactly_in_transaction();
+    return std::nullopt;
+  }
+  auto squared_pivots = recover_mean_locally();  // Omega is unchanged by what follows: the pivots hold
+  recover_exactly_if_stale();
+  return squared_pivots;
 }
 
 /// The iterated SEIF update: Gauss-Newton on the prior and the step's measurements, as the iterated
@@ -544,8 +555,36 @@ void SeifSlam<Motion, Sensor>::apply_mean_recovery(const std::vector<std::size_t
     move_landmark_mean(slots[a], dm);
     info_.landmark_residual(slots[a]) = r_after.template segment<M>(X + M * a);
     for (const auto& [neighbour, block] : info_.links(slots[a]))
-      if (!in_block(neighbour)) info_.landmark_residual(neighbour) -= block.transpose() * dm;
+      if (!in_block(neighbour)) {
+        info_.landmark_residual(neighbour) -= block.transpose() * dm;
+        if (stale_gate_ > 0.0) note_changed_residual(neighbour);
+      }
   }
+}
+
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::note_changed_residual(std::size_t slot) {
+  changed_marks_.resize(landmarks_.size(), 0);
+  if (changed_marks_[slot] == last_changed_mark_ + 1) return;
+  changed_marks_[slot] = last_changed_mark_ + 1;
+  changed_residuals_.push_back(slot);
+}
+
+/// A landmark p outside the block would move by delta_p = Omega_pp^-1 r_p given its neighbours
+/// (block coordinate descent's step, thesis eq. 34); delta_p^T Omega_pp delta_p = r_p^T Omega_pp^-1 r_p
+/// is that move in its conditional information.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::recover_exactly_if_stale() {
+  const bool stale = std::any_of(changed_residuals_.begin(), changed_residuals_.end(), [&](std::size_t slot) {
+    if (slot >= landmarks_.size()) return false;  // noted before a removal (a step that threw)
+    const Eigen::Matrix<double, M, 1> r = info_.landmark_residual(slot);
+    return r.dot(info_.diagonal(slot).llt().solve(r)) > stale_gate_;
+  });
+  changed_residuals_.clear();
+  ++last_changed_mark_;
+  if (!stale) return;
+  recover_mean_exactly_in_transaction();
+  recovered_stale_mean_ = true;
 }
 
 /// A test of membership in `slots` in O(1) without hashing: the slots get this call's mark.
@@ -575,7 +614,10 @@ void SeifSlam<Motion, Sensor>::recover_mean_by_coordinate_descent() {
       move_landmark_mean(slot, dm);
       info_.landmark_residual(slot) -= info_.diagonal(slot) * dm;
       info_.robot_residual() -= info_.robot_link(slot) * dm;
-      for (const auto& [neighbour, block] : info_.links(slot)) info_.landmark_residual(neighbour) -= block.transpose() * dm;
+      for (const auto& [neighbour, block] : info_.links(slot)) {
+        info_.landmark_residual(neighbour) -= block.transpose() * dm;
+        if (stale_gate_ > 0.0) note_changed_residual(neighbour);
+      }
     }
   }
 }
@@ -767,6 +809,7 @@ void SeifSlam<Motion, Sensor>::relocalize(const std::vector<MeasurementInformati
   Eigen::VectorXd squared_pivots;
   for (int sweep = 0; sweep < std::max(options_.mean_recovery_sweeps, 1); ++sweep)
     squared_pivots = recover_mean_of_block(block, active_queue_.size(), false);
+  recover_exactly_if_stale();
   require_factorizable_after_update(squared_pivots, std::nullopt);
 }
 
