@@ -25,6 +25,7 @@
 #include "sextant/core/landmark_pool.hpp"
 #include "sextant/core/linearized_observation.hpp"
 #include "sextant/core/sparse_cholesky.hpp"
+#include "sextant/core/slot_set.hpp"
 #include "sextant/core/sparse_information.hpp"
 #include "sextant/core/square_workspace.hpp"
 #include "sextant/core/update_result.hpp"
@@ -315,17 +316,15 @@ class SeifSlam {
   std::vector<Eigen::Index> unlinked_positions(const std::vector<std::size_t>& slots, std::size_t leading) const;
   void apply_mean_recovery(const std::vector<std::size_t>& slots, const Eigen::VectorXd& delta,
                            const Eigen::VectorXd& r_after);
-  /// Remembers, once per recovery, a landmark outside the block whose residual it changed.
-  void note_changed_residual(std::size_t slot);
-  /// SeifOptions::stale_mean_probability: the whole mean recovered exactly when a landmark noted by
-  /// note_changed_residual lags its neighbours by more than the gate.
+  /// SeifOptions::stale_mean_probability: the whole mean recovered exactly when a landmark in
+  /// changed_residuals_ lags its neighbours by more than the gate.
   void recover_exactly_if_stale();
   void robot_and_landmarks_block(const std::vector<std::size_t>& slots, Eigen::Ref<Eigen::MatrixXd> D) const;
   void gather_links_below(const std::vector<std::size_t>& slots, std::size_t a, Eigen::Ref<Eigen::MatrixXd> D,
                           std::size_t first) const;
   void fill_robot_and_diagonal_blocks(const std::vector<std::size_t>& slots, Eigen::Ref<Eigen::MatrixXd> D) const;
   static void require_factorizable_block(Eigen::Ref<Eigen::MatrixXd> D, const char* what);
-  /// A predicate true for exactly the given slots, valid until the next call.
+  /// A predicate true for exactly the given slots (in marked_slots_), valid until the next call.
   auto mark_slots(const std::vector<std::size_t>& slots);
   void update_active_queue(const std::vector<std::size_t>& observed_slots);
   /// ESEIF: the observations to relocalize the robot from, taken out of `observations`, when the
@@ -388,11 +387,9 @@ class SeifSlam {
   VersionedCache<Eigen::VectorXd> correction_;  ///< Omega^-1 r at revision_ (exact_mean only)
   SquareWorkspace block_workspace_;   ///< the dense robot-and-landmarks block of the step (scratch)
   SquareWorkspace factor_workspace_;  ///< its Cholesky factor (scratch)
-  std::vector<std::uint64_t> slot_marks_;  ///< mark_slots' marks, per slot (scratch)
-  std::uint64_t last_mark_ = 0;
-  std::vector<std::size_t> changed_residuals_;  ///< note_changed_residual's landmarks (scratch)
-  std::vector<std::uint64_t> changed_marks_;     ///< their marks, per slot (scratch)
-  std::uint64_t last_changed_mark_ = 0;
+  SlotSet marked_slots_;  ///< mark_slots' slots (scratch)
+  /// The landmarks outside a recovered block whose residual this update's recoveries changed (scratch).
+  SlotSet changed_residuals_;
 };
 
 }  // namespace sextant

@@ -233,7 +233,6 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
   auto relocalization = hold_back_for_relocalization(measurements, fresh.size());
   recovered_stale_mean_ = false;
   changed_residuals_.clear();
-  ++last_changed_mark_;
 
   atomically([&] {
     const State prior = x_;
@@ -557,17 +556,9 @@ void SeifSlam<Motion, Sensor>::apply_mean_recovery(const std::vector<std::size_t
     for (const auto& [neighbour, block] : info_.links(slots[a]))
       if (!in_block(neighbour)) {
         info_.landmark_residual(neighbour) -= block.transpose() * dm;
-        if (stale_gate_ > 0.0) note_changed_residual(neighbour);
+        if (stale_gate_ > 0.0) changed_residuals_.insert(neighbour);
       }
   }
-}
-
-template <class Motion, class Sensor>
-void SeifSlam<Motion, Sensor>::note_changed_residual(std::size_t slot) {
-  changed_marks_.resize(landmarks_.size(), 0);
-  if (changed_marks_[slot] == last_changed_mark_ + 1) return;
-  changed_marks_[slot] = last_changed_mark_ + 1;
-  changed_residuals_.push_back(slot);
 }
 
 /// A landmark p outside the block would move by delta_p = Omega_pp^-1 r_p given its neighbours
@@ -575,13 +566,13 @@ void SeifSlam<Motion, Sensor>::note_changed_residual(std::size_t slot) {
 /// is that move in its conditional information.
 template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::recover_exactly_if_stale() {
-  const bool stale = std::any_of(changed_residuals_.begin(), changed_residuals_.end(), [&](std::size_t slot) {
+  const auto& changed = changed_residuals_.members();
+  const bool stale = std::any_of(changed.begin(), changed.end(), [&](std::size_t slot) {
     if (slot >= landmarks_.size()) return false;  // noted before a removal (a step that threw)
     const Eigen::Matrix<double, M, 1> r = info_.landmark_residual(slot);
     return r.dot(info_.diagonal(slot).llt().solve(r)) > stale_gate_;
   });
   changed_residuals_.clear();
-  ++last_changed_mark_;
   if (!stale) return;
   recover_mean_exactly_in_transaction();
   recovered_stale_mean_ = true;
@@ -590,10 +581,9 @@ void SeifSlam<Motion, Sensor>::recover_exactly_if_stale() {
 /// A test of membership in `slots` in O(1) without hashing: the slots get this call's mark.
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::mark_slots(const std::vector<std::size_t>& slots) {
-  slot_marks_.resize(landmarks_.size(), 0);
-  const std::uint64_t mark = ++last_mark_;
-  for (std::size_t slot : slots) slot_marks_[slot] = mark;
-  return [this, mark](std::size_t slot) { return slot_marks_[slot] == mark; };
+  marked_slots_.clear();
+  for (std::size_t slot : slots) marked_slots_.insert(slot);
+  return [this](std::size_t slot) { return marked_slots_.contains(slot); };
 }
 
 /// Block coordinate descent on Omega delta = r over the robot and the active landmarks
@@ -616,7 +606,7 @@ void SeifSlam<Motion, Sensor>::recover_mean_by_coordinate_descent() {
       info_.robot_residual() -= info_.robot_link(slot) * dm;
       for (const auto& [neighbour, block] : info_.links(slot)) {
         info_.landmark_residual(neighbour) -= block.transpose() * dm;
-        if (stale_gate_ > 0.0) note_changed_residual(neighbour);
+        if (stale_gate_ > 0.0) changed_residuals_.insert(neighbour);
       }
     }
   }
