@@ -134,6 +134,24 @@ TEST(GraphSlam, Se2ProblemConvergesAndWindowedInitializationAgrees) {
   EXPECT_LT(worst_nees, test::nees_bound(3, true_poses.size()));
 }
 
+/// Exact odometry cannot make a motion factor, which weighs by R^-1: the pose is refused with an
+/// error naming the noise covariance (it named the joint covariance with the newest pose, which a
+/// user could not trace to the zero noise), and the graph keeps the poses it had.
+TEST(GraphSlam, ExactOdometryIsRefusedNamingItsNoiseCovariance) {
+  PointInRobotFrame2D sensor;
+  sensor.Q = 0.01 * Eigen::Matrix2d::Identity();
+  GraphSlam<Se2Odometry, PointInRobotFrame2D> graph{
+      Se2Odometry{}, sensor, {Eigen::Vector3d::Zero(), 1e-2 * Eigen::Matrix3d::Identity()}};
+  graph.predict({Eigen::Vector3d(0.5, 0.0, 0.1), 1e-4 * Eigen::Matrix3d::Identity()}, 1.0);
+  try {
+    graph.predict({Eigen::Vector3d(0.5, 0.0, 0.1), Eigen::Matrix3d::Zero()}, 1.0);
+    FAIL() << "exact odometry was taken";
+  } catch (const numerical_error& e) {
+    EXPECT_NE(std::string(e.what()).find("noise covariance"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(graph.num_poses(), 2u);
+}
+
 TEST(GraphSlam, RemoveLandmarkKeepsItsInformationAsALinearFactor) {
   const auto steps = test::random_linear_steps(30, 5, 12);
   Graph graph{kMotion, kSensor, kPrior};

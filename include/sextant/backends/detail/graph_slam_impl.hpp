@@ -170,7 +170,9 @@ auto GraphSlam<Motion, Sensor>::predict_if_observable(const State& x, const Land
 /// carried along, and the system map() and optimize() factorize is at least as ill-conditioned as
 /// the joint covariance [P, P J^T; J P, J P J^T + C] of x and y. If that is numerically singular
 /// (sigma 1e-100 against a 1e-2 prior, a landmark at 1e150 m, a step of 1e100) so is the system:
-/// the variable is rejected here instead of making every later map() and optimize() throw.
+/// the variable is rejected here instead of making every later map() and optimize() throw. The
+/// joint's Schur complement of P is C, so a singular C (exact odometry) makes it singular: the
+/// message then names C, which a factor weighs by its inverse.
 template <class Motion, class Sensor>
 template <int D>
 void GraphSlam<Motion, Sensor>::require_factorizable_extension(const Eigen::Matrix<double, X, X>& P,
@@ -182,7 +184,13 @@ void GraphSlam<Motion, Sensor>::require_factorizable_extension(const Eigen::Matr
   joint.template bottomLeftCorner<D, X>() = J * P;
   joint.template topRightCorner<X, D>() = joint.template bottomLeftCorner<D, X>().transpose();
   joint.template bottomRightCorner<D, D>() = symmetrized(J * P * J.transpose() + C);
-  require_well_conditioned(joint, what + ": its joint covariance with the newest pose");
+  try {
+    require_well_conditioned(joint, what + ": its joint covariance with the newest pose");
+  } catch (const numerical_error&) {
+    require_well_conditioned(C, what + ": its noise covariance, whose inverse weighs its factor (exact motion or "
+                                       "measurements need a small positive noise here)");
+    throw;
+  }
 }
 
 /// The motion factor between poses k and k + 1 at `from` and `to`: the model's own between() when
