@@ -88,7 +88,9 @@ BackendRun<Dataset> run_backend(const BackendChoice& choice, const Dataset& data
     if (c.association.method && associates(choice.kind)) {  // the ids withheld and associated
       if constexpr (requires { backend.particles(); }) {   // per particle by maximum likelihood, whatever the method
         eval::ParticleAssociation withheld(backend);
-        return finish(withheld, evaluate(withheld));
+        finish(withheld, evaluate(withheld));
+        out.association = withheld.score();
+        return;
       } else if constexpr (requires { backend.joint_marginal(std::span<const LandmarkId>{}); }) {
         AssociationOptions options = c.association.options;
         options.method = *c.association.method;

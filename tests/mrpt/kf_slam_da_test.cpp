@@ -124,10 +124,16 @@ TEST_F(KfSlamDaDemo, SeifAndFastSlamAssociateToo) {
   EXPECT_LE(fast.map().size(), data.true_landmarks.size() + 1);
   EXPECT_TRUE(fast.pose().mean.allFinite());
   EXPECT_LT(eval::mean(fast_run.map_error_aligned), 2.0 * ids_aligned);
+  // Scored step by step by the particle most likely at the step: the ids are clear-cut here (the
+  // test above), so no pairing of it is wrong, and it paired most re-observations (correct > 0).
+  const auto& fast_score = fast_withheld.score();
+  EXPECT_EQ(fast_score.wrong(), 0u);
+  EXPECT_GT(fast_score.correct(), 0u);
   std::printf("aligned map error [m]: EKF+JCBB %.4f, SEIF 8 active+JCBB %.4f, FastSLAM 2.0 per-particle %.4f (with the "
-              "true ids %.4f); FastSLAM landmarks %zu\n",
+              "true ids %.4f); FastSLAM landmarks %zu; its most likely particle's association step by step: precision "
+              "%.4f, recall %.4f, %zu duplicates\n",
               ekf_aligned, eval::mean(seif_run.map_error_aligned), eval::mean(fast_run.map_error_aligned), ids_aligned,
-              fast.map().size());
+              fast.map().size(), fast_score.precision(), fast_score.recall(), fast_score.duplicates());
 }
 
 }  // namespace

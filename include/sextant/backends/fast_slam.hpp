@@ -130,8 +130,11 @@ class FastSlam {
   /// Measurements without ids: each particle associates them to its own landmarks by maximum
   /// likelihood, or starts new ones (thesis §7.2). A new landmark gets the next id from
   /// options().first_unassociated_id on; `initialized` counts those of the most likely particle,
-  /// whose landmarks map() lists beside the known ones.
-  UpdateResult update_unassociated(std::span<const Measurement> measurements);
+  /// whose landmarks map() lists beside the known ones. `most_likely`, when given, receives per
+  /// measurement the id of the landmark that particle paired it with or started for it (the
+  /// association a run with the ids withheld is scored by; eval/particle_association.hpp).
+  UpdateResult update_unassociated(std::span<const Measurement> measurements,
+                                   std::vector<LandmarkId>* most_likely = nullptr);
 
   void remove_landmark(LandmarkId id);
 

@@ -51,6 +51,11 @@ class AssociationScore {
     if (!result.search_complete) ++searches_cut_;
   }
 
+  /// Notes the true id of a landmark another hypothesis created, counting nothing: FastSLAM's
+  /// particles start their own landmarks, and the particle scored in a later step may pair a
+  /// measurement with one that the particle scored when it was made had not started.
+  void note_created(LandmarkId created, LandmarkId truth) { truth_of_.emplace(created, truth); }
+
   /// The true id of a landmark the association created, none for one it did not.
   std::optional<LandmarkId> truth_of(LandmarkId created) const {
     const auto it = truth_of_.find(created);

@@ -3,6 +3,8 @@
 /// FastSlam::update_unassociated, where each particle associates them by maximum likelihood (thesis
 /// §7.2), and map() reports each landmark under the true id of the measurement that created it, so
 /// the run is scored like one with known ids (the particle-filter counterpart of eval::WithheldIds).
+/// score() scores each step's association made by the particle most likely at that step, the one
+/// whose landmarks map() lists.
 ///
 /// FastSLAM gives the landmark that the g-th measurement handed to update_unassociated starts the id
 /// first_unassociated_id + g, in every particle that starts one for it; that is how a landmark is
@@ -13,6 +15,7 @@
 
 #include "sextant/core/observation.hpp"
 #include "sextant/core/update_result.hpp"
+#include "sextant/eval/association_score.hpp"
 
 namespace sextant::eval {
 
@@ -29,13 +32,25 @@ class ParticleAssociation {
 
   void predict(const Control& u, double dt) { backend_.predict(u, dt); }
 
-  /// Hands the measurements over without their ids, which are kept to score the map.
+  /// Hands the measurements over without their ids, which are kept to score the association and the map.
   UpdateResult update(std::span<const ObservationType> observations) {
     std::vector<Measurement> z;
-    z.reserve(observations.size());
-    for (const auto& o : observations) z.push_back(o.z);
-    const UpdateResult result = backend_.update_unassociated(std::span<const Measurement>(z));
-    for (const auto& o : observations) truth_.push_back(o.landmark_id);  // after the update: it may throw
+    std::vector<LandmarkId> truth;
+    for (const auto& o : observations) {
+      z.push_back(o.z);
+      truth.push_back(o.landmark_id);
+    }
+    std::vector<LandmarkId> chosen;
+    const UpdateResult result = backend_.update_unassociated(std::span<const Measurement>(z), &chosen);
+    const LandmarkId first_new = backend_.options().first_unassociated_id + handed_over_;  // this step's new ids
+    handed_over_ += z.size();
+    AssociationResult<Measurement> association;
+    for (std::size_t i = 0; i < z.size(); ++i) {
+      score_.note_created(first_new + i, truth[i]);  // some particle may have started it
+      association.outcome.push_back(chosen[i] >= first_new ? AssociationOutcome::new_landmark : AssociationOutcome::paired);
+      association.id.push_back(chosen[i]);
+    }
+    score_.record(std::span<const LandmarkId>(truth), association);
     return result;
   }
   UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }
@@ -44,16 +59,18 @@ class ParticleAssociation {
   /// The back-end's map, each landmark under the true id of the measurement that created it.
   auto map() const {
     auto map = backend_.map();
-    const LandmarkId first = backend_.options().first_unassociated_id;
-    for (auto& landmark : map)
-      if (landmark.id >= first && landmark.id - first < truth_.size()) landmark.id = truth_[landmark.id - first];
+    for (auto& landmark : map) landmark.id = score_.truth_of(landmark.id).value_or(landmark.id);
     return map;
   }
   void remove_landmark(LandmarkId id) { backend_.remove_landmark(id); }
 
+  /// The association of the step's most likely particle, step by step.
+  const AssociationScore& score() const { return score_; }
+
  private:
   Backend& backend_;
-  std::vector<LandmarkId> truth_;  ///< [g]: true id of the g-th measurement handed over
+  std::size_t handed_over_ = 0;  ///< measurements handed to update_unassociated so far
+  AssociationScore score_;
 };
 
 }  // namespace sextant::eval

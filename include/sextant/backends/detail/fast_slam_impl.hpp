@@ -422,7 +422,8 @@ auto FastSlam<Motion, Sensor, Map>::add_new_landmarks(std::vector<Particle>& par
 /// pose is sampled after the associated measurements have shaped it. A landmark started from the
 /// i-th measurement gets the id next_unassociated_id + i in every particle that starts it.
 template <class Motion, class Sensor, template <class> class Map>
-UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const Measurement> measurements) {
+UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const Measurement> measurements,
+                                                                std::vector<LandmarkId>* most_likely) {
   for (const auto& z : measurements) require_finite(z, "unassociated measurement");
   Transaction t = begin();
   const bool proposal = options_.version == FastSlamVersion::v2 && !t.pending.empty();
@@ -430,8 +431,12 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
   for (std::size_t n = 0; n < t.particles.size(); ++n)
     match[n] = associate_and_propose(t.particles[n], measurements, proposal, t.pending);
   t.pending.clear();
-  const auto& chosen = match[best_particle(t.particles)];
+  const std::size_t best = best_particle(t.particles);
+  const auto& chosen = match[best];
   const auto initialized = static_cast<std::size_t>(std::count(chosen.begin(), chosen.end(), kNewLandmark));
+  std::vector<LandmarkId> chosen_ids(measurements.size());
+  for (std::size_t i = 0; i < measurements.size(); ++i)
+    chosen_ids[i] = chosen[i] == kNewLandmark ? t.next_unassociated_id + i : t.particles[best].unassociated[chosen[i]].id;
   for (std::size_t n = 0; !proposal && n < t.particles.size(); ++n)  // weighed by the updates themselves
     map_unassociated(t.particles[n], measurements, match[n], false, t);
   const auto parents = normalize_and_resample(t);  // with the frame as the particles were drawn in (point_support)
@@ -440,6 +445,7 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
   t.next_unassociated_id += measurements.size();
   fix_frame_if_mapped(t);
   commit(std::move(t));
+  if (most_likely) *most_likely = std::move(chosen_ids);
   return {measurements.size() - initialized, initialized, {}, {}};
 }
 
