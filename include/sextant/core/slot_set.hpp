@@ -11,7 +11,7 @@ namespace sextant {
 /// per-step scratch sets of a back-end, which would otherwise clear a per-slot flag vector each step.
 class SlotSet {
  public:
-  /// Empties the set in O(members) (the marks stay; a new mark makes them stale).
+  /// Empties the set (the marks stay: the new mark makes them stale).
   void clear() {
     ++mark_;
     members_.clear();

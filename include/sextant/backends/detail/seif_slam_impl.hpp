@@ -578,7 +578,7 @@ void SeifSlam<Motion, Sensor>::recover_exactly_if_stale() {
   recovered_stale_mean_ = true;
 }
 
-/// A test of membership in `slots` in O(1) without hashing: the slots get this call's mark.
+/// A test of membership in `slots` in O(1) without hashing (core/slot_set.hpp).
 template <class Motion, class Sensor>
 auto SeifSlam<Motion, Sensor>::mark_slots(const std::vector<std::size_t>& slots) {
   marked_slots_.clear();
