@@ -431,14 +431,16 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
   for (std::size_t n = 0; n < t.particles.size(); ++n)
     match[n] = associate_and_propose(t.particles[n], measurements, proposal, t.pending);
   t.pending.clear();
+  for (std::size_t n = 0; !proposal && n < t.particles.size(); ++n)  // weighed by the updates themselves
+    map_unassociated(t.particles[n], measurements, match[n], false, t);
+  // The most likely particle given this step's measurements: each particle's weight holds them now
+  // (FastSLAM 2.0's proposal factor, 1.0's updates), and new landmarks went to the end of its list.
   const std::size_t best = best_particle(t.particles);
   const auto& chosen = match[best];
   const auto initialized = static_cast<std::size_t>(std::count(chosen.begin(), chosen.end(), kNewLandmark));
   std::vector<LandmarkId> chosen_ids(measurements.size());
   for (std::size_t i = 0; i < measurements.size(); ++i)
     chosen_ids[i] = chosen[i] == kNewLandmark ? t.next_unassociated_id + i : t.particles[best].unassociated[chosen[i]].id;
-  for (std::size_t n = 0; !proposal && n < t.particles.size(); ++n)  // weighed by the updates themselves
-    map_unassociated(t.particles[n], measurements, match[n], false, t);
   const auto parents = normalize_and_resample(t);  // with the frame as the particles were drawn in (point_support)
   for (std::size_t n = 0; proposal && n < t.particles.size(); ++n)  // each copy draws its own pose, as in update()
     map_unassociated(t.particles[n], measurements, match[parents[n]], true, t);
