@@ -125,7 +125,7 @@ TEST_F(KfSlamDaDemo, SeifAndFastSlamAssociateToo) {
   EXPECT_TRUE(fast.pose().mean.allFinite());
   EXPECT_LT(eval::mean(fast_run.map_error_aligned), 2.0 * ids_aligned);
   // Scored step by step by the particle most likely at the step: the ids are clear-cut here (the
-  // test above), so no pairing of it is wrong, and it paired most re-observations (correct > 0).
+  // test above), so no pairing of it is wrong, and it paired re-observations (correct > 0).
   const auto& fast_score = fast_withheld.score();
   EXPECT_EQ(fast_score.wrong(), 0u);
   EXPECT_GT(fast_score.correct(), 0u);

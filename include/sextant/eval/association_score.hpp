@@ -9,11 +9,32 @@
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
+#include <vector>
 
 #include "sextant/core/data_association.hpp"
 #include "sextant/core/error.hpp"
 
 namespace sextant::eval {
+
+/// A step's observations split as a run with the ids withheld needs them: the measurements it hands
+/// over, and apart from them the true ids it scores by.
+template <class Measurement>
+struct WithheldStep {
+  std::vector<Measurement> z;
+  std::vector<LandmarkId> truth;
+};
+
+template <class Measurement>
+WithheldStep<Measurement> withhold_ids(std::span<const Observation<Measurement>> observations) {
+  WithheldStep<Measurement> step;
+  step.z.reserve(observations.size());
+  step.truth.reserve(observations.size());
+  for (const auto& o : observations) {
+    step.z.push_back(o.z);
+    step.truth.push_back(o.landmark_id);
+  }
+  return step;
+}
 
 class AssociationScore {
  public:

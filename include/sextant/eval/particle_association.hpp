@@ -34,23 +34,18 @@ class ParticleAssociation {
 
   /// Hands the measurements over without their ids, which are kept to score the association and the map.
   UpdateResult update(std::span<const ObservationType> observations) {
-    std::vector<Measurement> z;
-    std::vector<LandmarkId> truth;
-    for (const auto& o : observations) {
-      z.push_back(o.z);
-      truth.push_back(o.landmark_id);
-    }
+    const auto step = withhold_ids(observations);
     std::vector<LandmarkId> chosen;
-    const UpdateResult result = backend_.update_unassociated(std::span<const Measurement>(z), &chosen);
+    const UpdateResult result = backend_.update_unassociated(std::span<const Measurement>(step.z), &chosen);
     const LandmarkId first_new = backend_.options().first_unassociated_id + handed_over_;  // this step's new ids
-    handed_over_ += z.size();
+    handed_over_ += step.z.size();
     AssociationResult<Measurement> association;
-    for (std::size_t i = 0; i < z.size(); ++i) {
-      score_.note_created(first_new + i, truth[i]);  // some particle may have started it
+    for (std::size_t i = 0; i < step.z.size(); ++i) {
+      score_.note_created(first_new + i, step.truth[i]);  // some particle may have started it
       association.outcome.push_back(chosen[i] >= first_new ? AssociationOutcome::new_landmark : AssociationOutcome::paired);
       association.id.push_back(chosen[i]);
     }
-    score_.record(std::span<const LandmarkId>(truth), association);
+    score_.record(std::span<const LandmarkId>(step.truth), association);
     return result;
   }
   UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }

@@ -29,15 +29,10 @@ class WithheldIds {
 
   /// Associates the measurements (their ids are used only to score the association), then updates.
   UpdateResult update(std::span<const ObservationType> observations) {
-    std::vector<Measurement> z;
-    std::vector<LandmarkId> truth;
-    for (const auto& o : observations) {
-      z.push_back(o.z);
-      truth.push_back(o.landmark_id);
-    }
-    const auto result = association_.associate(backend_, std::span<const Measurement>(z));
+    const auto step = withhold_ids(observations);
+    const auto result = association_.associate(backend_, std::span<const Measurement>(step.z));
     const UpdateResult update = backend_.update(result.observations);
-    score_.record(std::span<const LandmarkId>(truth), result);
+    score_.record(std::span<const LandmarkId>(step.truth), result);
     return update;
   }
   UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }

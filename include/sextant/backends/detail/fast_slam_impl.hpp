@@ -438,9 +438,10 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
   const std::size_t best = best_particle(t.particles);
   const auto& chosen = match[best];
   const auto initialized = static_cast<std::size_t>(std::count(chosen.begin(), chosen.end(), kNewLandmark));
-  std::vector<LandmarkId> chosen_ids(measurements.size());
-  for (std::size_t i = 0; i < measurements.size(); ++i)
-    chosen_ids[i] = chosen[i] == kNewLandmark ? t.next_unassociated_id + i : t.particles[best].unassociated[chosen[i]].id;
+  std::vector<LandmarkId> chosen_ids;  // only for a caller that asked
+  for (std::size_t i = 0; most_likely && i < measurements.size(); ++i)
+    chosen_ids.push_back(chosen[i] == kNewLandmark ? t.next_unassociated_id + i
+                                                   : t.particles[best].unassociated[chosen[i]].id);
   const auto parents = normalize_and_resample(t);  // with the frame as the particles were drawn in (point_support)
   for (std::size_t n = 0; proposal && n < t.particles.size(); ++n)  // each copy draws its own pose, as in update()
     map_unassociated(t.particles[n], measurements, match[parents[n]], true, t);
