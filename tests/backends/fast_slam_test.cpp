@@ -450,6 +450,32 @@ TEST(FastSlam, TheReportedAssociationIsThatOfTheParticleMostLikelyAfterTheStep) 
   EXPECT_EQ(chosen[0], options.first_unassociated_id);  // the landmark the first step started
 }
 
+/// Resampling leaves every weight equal, so "the particle with the largest weight" must be taken
+/// before it: map() then lists the first copy of that particle, not the sampler's first draw. Two
+/// FastSLAM 1.0 filters draw the same poses (same seed; the first update leaves the weights equal and
+/// resamples in neither); the one that never resamples shows the most likely particle's landmark, and
+/// the one that resamples after the informative second update must show the same landmark exactly.
+TEST(FastSlam, AfterResamplingTheMapIsThatOfTheParticleMostLikelyBeforeIt) {
+  const Gaussian<Eigen::Vector2d, 2> prior{Eigen::Vector2d::Zero(), 1e-6 * Eigen::Matrix2d::Identity()};
+  const auto run = [&](double resample_threshold) {
+    Fast fast{BeaconShip2D{}, BeaconOffset2D{0.5}, prior,
+              {.particles = 50, .version = FastSlamVersion::v1, .resample_threshold = resample_threshold}};
+    fast.update(std::vector<Fast::ObservationType>{{1, {10.0, 0.0}}, {2, {0.0, 10.0}}});
+    fast.predict(Eigen::Vector2d(10.0, 0.0), 1.0);  // the cloud spreads over metres, the weights over many
+    fast.update(std::vector<Fast::ObservationType>{{1, {0.0, 0.0}}});
+    return std::pair{fast.map(), fast.resamplings()};
+  };
+  const auto [kept, none] = run(0.0);
+  const auto [resampled, once] = run(0.99);
+  ASSERT_EQ(none, 0u);
+  ASSERT_EQ(once, 1u);
+  ASSERT_EQ(kept.size(), resampled.size());
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    EXPECT_EQ(kept[i].id, resampled[i].id);
+    EXPECT_EQ(kept[i].mean, resampled[i].mean) << kept[i].id;
+  }
+}
+
 TEST_P(FastVersions, ALandmarkObservedAgainAfterRemovalIsListedOnceWithItsNewEstimate) {
   const Gaussian<Eigen::Vector2d, 2> prior{Eigen::Vector2d::Zero(), 1e-6 * Eigen::Matrix2d::Identity()};
   Fast fast{BeaconShip2D{}, BeaconOffset2D{0.5}, prior, {.particles = 10, .version = GetParam()}};

@@ -184,9 +184,10 @@ class FastSlam {
     bool resampled = false;
     Eigen::Matrix<double, X, X> frame_cov;
     bool frame_fixed;
+    std::size_t best;  ///< the most likely particle (see best_)
   };
   Transaction begin() const {
-    return {particles_, rng_, estimate_, support_, pending_, next_unassociated_id_, false, frame_cov_, frame_fixed_};
+    return {particles_, rng_, estimate_, support_, pending_, next_unassociated_id_, false, frame_cov_, frame_fixed_, best_};
   }
   /// Before the first landmark the particles would differ only by where they put the map (a rigid
   /// motion no later measurement can see): they move together at the dead-reckoned mean, and the
@@ -258,7 +259,7 @@ class FastSlam {
     return it != index_.end() && it->second == index;
   }
   static std::size_t best_particle(const std::vector<Particle>& particles);
-  std::size_t best_particle() const { return best_particle(particles_); }
+  std::size_t best_particle() const { return best_; }
   std::optional<LandmarkEstimate<M>> unassociated_landmark(LandmarkId id) const;
   /// A landmark covariance in the particles' frame plus the frame's uncertainty (its translation:
   /// the leading M entries of the state, as the runner's scoring assumes).
@@ -285,6 +286,9 @@ class FastSlam {
   /// added to the reported covariances (without the lever arm of its rotation part).
   Eigen::Matrix<double, X, X> frame_cov_;
   bool frame_fixed_ = false;  ///< a landmark has been mapped
+  /// The particle with the largest weight; after a resampling, which leaves every weight equal, the
+  /// first copy of the one that had it before (the most likely particle, not the sampler's first draw).
+  std::size_t best_ = 0;
 };
 
 }  // namespace sextant

@@ -80,6 +80,7 @@ void FastSlam<Motion, Sensor, Map>::commit(Transaction&& t) {
   if (t.resampled) ++resamplings_;
   frame_cov_ = t.frame_cov;
   frame_fixed_ = t.frame_fixed;
+  best_ = t.best;
 }
 
 /// Dead reckoning of the common pose and of its covariance, Sigma <- G Sigma G^T + R, split into the
@@ -349,16 +350,14 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
     outcomes[n] = proposal ? propose_v2(t.particles[n], priors[n], known, accepted)
                            : update_known_landmarks(t.particles[n], known, accepted);
   t.pending.clear();
-  const std::size_t best = best_particle(t.particles);
-  std::vector<Outcome> reported = outcomes[best];
   const auto parents = normalize_and_resample(t);  // with the frame as the particles were drawn in (point_support)
+  std::vector<Outcome> reported = outcomes[parents[t.best]];
   // FastSLAM 2.0's weight does not depend on the draw, so the cloud was resampled first and each
   // copy of a particle draws its own pose (the fully adapted order; Pitt and Shephard, JASA 1999).
-  const auto copy_of_best = static_cast<std::size_t>(std::find(parents.begin(), parents.end(), best) - parents.begin());
   for (std::size_t n = 0; proposal && n < t.particles.size(); ++n) {
     std::vector<Outcome> drawn = outcomes[parents[n]];
     draw_from_proposal(t.particles[n], known, drawn, t.rng);
-    if (n == copy_of_best) reported = std::move(drawn);
+    if (n == t.best) reported = std::move(drawn);
   }
   UpdateResult result;
   const auto added = add_new_landmarks(t.particles, fresh, result.unusable);
@@ -433,16 +432,15 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
   t.pending.clear();
   for (std::size_t n = 0; !proposal && n < t.particles.size(); ++n)  // weighed by the updates themselves
     map_unassociated(t.particles[n], measurements, match[n], false, t);
-  // The most likely particle given this step's measurements: each particle's weight holds them now
-  // (FastSLAM 2.0's proposal factor, 1.0's updates), and new landmarks went to the end of its list.
-  const std::size_t best = best_particle(t.particles);
-  const auto& chosen = match[best];
+  const auto parents = normalize_and_resample(t);  // with the frame as the particles were drawn in (point_support)
+  // The most likely particle given this step's measurements: each particle's weight held them
+  // (FastSLAM 2.0's proposal factor, 1.0's updates), and new landmarks go to the end of its list.
+  const auto& chosen = match[parents[t.best]];
   const auto initialized = static_cast<std::size_t>(std::count(chosen.begin(), chosen.end(), kNewLandmark));
   std::vector<LandmarkId> chosen_ids;  // only for a caller that asked
   for (std::size_t i = 0; most_likely && i < measurements.size(); ++i)
     chosen_ids.push_back(chosen[i] == kNewLandmark ? t.next_unassociated_id + i
-                                                   : t.particles[best].unassociated[chosen[i]].id);
-  const auto parents = normalize_and_resample(t);  // with the frame as the particles were drawn in (point_support)
+                                                   : t.particles[t.best].unassociated[chosen[i]].id);
   for (std::size_t n = 0; proposal && n < t.particles.size(); ++n)  // each copy draws its own pose, as in update()
     map_unassociated(t.particles[n], measurements, match[parents[n]], true, t);
   t.next_unassociated_id += measurements.size();
@@ -454,11 +452,13 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
 
 /// Normalizes the log weights (log-sum-exp), keeps the weighted cloud as the pose estimate, and
 /// resamples by the low-variance sampler (§3.7.4) when the effective sample size falls below the
-/// threshold. Returns each particle's parent in the cloud before (itself when none was resampled).
+/// threshold; t.best becomes the most likely particle (the first copy of it after a resampling).
+/// Returns each particle's parent in the cloud before (itself when none was resampled).
 template <class Motion, class Sensor, template <class> class Map>
 std::vector<std::size_t> FastSlam<Motion, Sensor, Map>::normalize_and_resample(Transaction& t) const {
   auto& particles = t.particles;
-  const double max_log = particles[best_particle(particles)].log_weight;
+  t.best = best_particle(particles);
+  const double max_log = particles[t.best].log_weight;
   if (!std::isfinite(max_log)) throw numerical_error("FastSLAM particle weights are not finite");
   double sum = 0.0;
   for (const auto& p : particles) sum += std::exp(p.log_weight - max_log);
@@ -484,6 +484,8 @@ std::vector<std::size_t> FastSlam<Motion, Sensor, Map>::normalize_and_resample(T
   }
   particles = std::move(resampled);
   t.resampled = true;
+  // A particle of weight >= 1/n, as the largest is, keeps a copy under the low-variance sampler.
+  t.best = static_cast<std::size_t>(std::find(parents.begin(), parents.end(), t.best) - parents.begin());
   return parents;
 }
 
