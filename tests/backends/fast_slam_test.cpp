@@ -450,6 +450,23 @@ TEST(FastSlam, TheReportedAssociationIsThatOfTheParticleMostLikelyAfterTheStep) 
   EXPECT_EQ(chosen[0], options.first_unassociated_id);  // the landmark the first step started
 }
 
+/// The ship's beacon offsets are linear in the pose, where Gauss-Newton converges in one step: the
+/// iterated proposal's second pass, linearized at the first's mean with its residual referred back
+/// to the running mean, must give the textbook proposal again (a wrong reference moves it by the
+/// first pass's correction), so the same draws, weights and resamplings follow to rounding.
+TEST(FastSlam, OnALinearModelTheIteratedProposalIsTheTextbookOne) {
+  const auto data = sim::simulate_ship_2d({.seed = 5, .num_steps = 200});
+  Fast textbook{data.motion, data.sensor, data.prior, {.particles = 20}};
+  Fast iterated{data.motion, data.sensor, data.prior, {.particles = 20, .iterations = 4}};
+  eval::run(textbook, data.steps);
+  eval::run(iterated, data.steps);
+  ASSERT_GT(textbook.resamplings(), 0u);
+  EXPECT_EQ(iterated.resamplings(), textbook.resamplings());
+  EXPECT_LT((iterated.pose().mean - textbook.pose().mean).norm(), 1e-9 * textbook.pose().mean.norm());
+  const auto w = textbook.weights(), v = iterated.weights();
+  for (std::size_t n = 0; n < w.size(); ++n) EXPECT_NEAR(v[n], w[n], 1e-9) << n;
+}
+
 /// Resampling leaves every weight equal, so "the particle with the largest weight" must be taken
 /// before it: map() then lists the first copy of that particle, not the sampler's first draw. Two
 /// FastSLAM 1.0 filters draw the same poses (same seed; the first update leaves the weights equal and

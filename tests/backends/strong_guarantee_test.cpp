@@ -188,6 +188,13 @@ struct FastSlamTwo {
                                                 {.particles = 6, .version = FastSlamVersion::v2, .resample_threshold = 0.9}};
   }
 };
+struct FastSlamTwoIterated {  // a fault in any pass of the iterated proposal
+  static auto make() {
+    return FastSlam<FaultyMotion, FaultySensor>{
+        FaultyMotion{}, FaultySensor{}, test::kLinearPrior,
+        {.particles = 6, .version = FastSlamVersion::v2, .resample_threshold = 0.9, .iterations = 3}};
+  }
+};
 
 template <class Config>
 class StrongGuarantee : public ::testing::Test {
@@ -245,7 +252,7 @@ class StrongGuarantee : public ::testing::Test {
 
 using Configs = ::testing::Types<EkfBatch, EkfSequential, EkfJoseph, EkfIterated, SeifSparsified, SeifRelocalization,
                                  SeifRelocalizationIterated, SeifCoordinateDescent, Graph,
-                                 GraphOnline, GraphFixedLag, FastSlamOne, FastSlamTwo>;
+                                 GraphOnline, GraphFixedLag, FastSlamOne, FastSlamTwo, FastSlamTwoIterated>;
 TYPED_TEST_SUITE(StrongGuarantee, Configs);
 
 /// 10 steps on the linear test problem, a removal every third step (the removed id comes back

@@ -64,6 +64,13 @@ struct FastSlamOptions {
   double gate_probability = 0.0;
   /// docs/results/globe.md measures both on the 12D camera.
   FastSlamLinearTail linear_tail = FastSlamLinearTail::sampled;
+  /// FastSLAM 2.0's proposal iterated (EkfOptions::iterations' Gauss-Newton, over a particle's pose
+  /// and the observed landmarks, these marginalized): up to this many linearizations of the step's
+  /// known-landmark measurements, each at the previous one's pose and the landmarks' means given it. 1 = the textbook proposal, each measurement linearized
+  /// where the ones before it moved the mean. update_unassociated folds once (its association decides
+  /// as it folds). It matters where a landmark is close to the sensor compared with the pose's spread
+  /// (docs/results/iterated_ekf.md).
+  int iterations = 1;
 };
 
 /// One landmark of one particle: an EKF over its position (eqs. 75-78).
@@ -232,6 +239,31 @@ class FastSlam {
   static double fold_into_proposal(State& mean, PoseMatrix& cov, const ProposalInnovation& innovation);
   std::vector<Outcome> propose_v2(Particle& particle, const PoseEstimate& prior, std::span<const ObservationType> known,
                                   const std::vector<bool>& accepted) const;
+  /// Where a pass of the iterated proposal linearizes: a pose, and per measurement its landmark.
+  struct ProposalLinearization {
+    State x;
+    std::vector<Landmark> m;
+  };
+  /// A Gaussian proposal of a particle's pose, the particle's log weight with it, and (iterated) where
+  /// the next pass linearizes.
+  struct FoldedProposal {
+    State mean;
+    PoseMatrix cov;
+    double log_weight;
+    ProposalLinearization next;
+  };
+  std::optional<FoldedProposal> fold_proposal(const Particle& particle, const PoseEstimate& prior,
+                                              std::span<const ObservationType> known, std::vector<Outcome>& outcomes,
+                                              const ProposalLinearization* at) const;
+  /// A measurement a pass folded: its index, the pose it was linearized at, its innovation.
+  struct FoldedMeasurement {
+    std::size_t i;
+    State x_i;
+    ProposalInnovation innovation;
+  };
+  ProposalLinearization next_linearization(const Particle& particle, std::span<const ObservationType> known,
+                                           const State& x, const std::vector<FoldedMeasurement>& folded,
+                                           const ProposalLinearization* at) const;
   void draw_from_proposal(Particle& particle, std::span<const ObservationType> known, std::vector<Outcome>& outcomes,
                           std::mt19937_64& rng) const;
   std::vector<PoseEstimate> pose_priors(const std::vector<Particle>& particles, const PendingMotion* motion) const;

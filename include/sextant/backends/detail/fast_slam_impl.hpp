@@ -22,6 +22,8 @@ FastSlam<Motion, Sensor, Map>::FastSlam(Motion motion, Sensor sensor, const Pose
       next_unassociated_id_(options.first_unassociated_id),
       rng_(options.seed) {
   if (options_.particles == 0) throw invalid_input_error("FastSlamOptions: particles must be > 0");
+  if (options_.iterations < 1)
+    throw invalid_input_error("FastSlamOptions: iterations must be at least 1 (got " + std::to_string(options_.iterations) + ")");
   if (!(options_.resample_threshold >= 0.0 && options_.resample_threshold <= 1.0))
     throw invalid_input_error("FastSlamOptions: resample_threshold must be in [0, 1]");
   if (!Space::is_finite(prior.mean)) throw invalid_input_error("prior mean contains NaN or Inf");
@@ -218,31 +220,87 @@ double FastSlam<Motion, Sensor, Map>::fold_into_proposal(State& mean, PoseMatrix
 /// FastSLAM 2.0's Gaussian proposal of one particle's pose, folded from its motion prior and the
 /// accepted observations of known landmarks (kept as Particle::drawn_from, drawn_cov); its weight
 /// factor (eq. 93) is added to the particle. Nothing is drawn: the weight depends on the particle
-/// before the draw, which is what lets update() resample first (draw_from_proposal).
+/// before the draw, which is what lets update() resample first (draw_from_proposal). With
+/// options().iterations > 1 the proposal is iterated as the iterated EKF's update is (Gauss-Newton
+/// on the prior, the landmarks' priors and the measurements, the landmarks marginalized): each
+/// further pass linearizes every measurement at the last pass's pose and at its landmark's mean given
+/// that pose, until the pose moves by less than 1e-9 of the step; the weight is the last pass's.
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::propose_v2(Particle& particle, const PoseEstimate& prior,
                                                std::span<const ObservationType> known,
                                                const std::vector<bool>& accepted) const -> std::vector<Outcome> {
-  State mean = prior.mean;
-  PoseMatrix cov = prior.cov;
   std::vector<Outcome> outcomes(known.size(), Outcome::used);
+  for (std::size_t i = 0; i < known.size(); ++i)
+    if (!accepted[i]) outcomes[i] = Outcome::gated;
+  FoldedProposal proposal = *fold_proposal(particle, prior, known, outcomes, nullptr);
+  for (int pass = 1; pass < options_.iterations; ++pass) {
+    auto next = fold_proposal(particle, prior, known, outcomes, &proposal.next);
+    if (!next) break;  // a measurement the model cannot predict from the iterate ends the iterations
+    const double moved = Space::minus(next->mean, proposal.mean).template lpNorm<Eigen::Infinity>();
+    const double step = Space::minus(next->mean, prior.mean).template lpNorm<Eigen::Infinity>();
+    proposal = std::move(*next);
+    if (moved <= 1e-9 * (1.0 + step)) break;
+  }
+  if (!std::isfinite(proposal.log_weight)) throw numerical_error("FastSLAM 2.0 proposal weight is not finite");
+  particle.log_weight = proposal.log_weight;
+  particle.drawn_from = std::move(proposal.mean);
+  particle.drawn_cov = std::move(proposal.cov);
+  return outcomes;
+}
+
+/// One pass of the proposal: the measurements whose outcome is `used` folded one by one into the
+/// motion prior. The first pass (`at` null) is the textbook proposal: each measurement linearized at
+/// the running mean and its landmark's mean (and marked unusable where the model cannot predict it).
+/// A further pass linearizes measurement i at (at->x, at->m[i]) and refers its residual back to the
+/// running mean mu and the landmark's mean m: nu = z - h(x_i, m_i) - H_x (mu - x_i) - H_m (m - m_i)
+/// (nothing where the model cannot predict one). The weight starts from the particle's and gains each
+/// log N(nu; 0, S). With iterations asked for, the pass also gives the next one's linearization.
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::fold_proposal(const Particle& particle, const PoseEstimate& prior,
+                                                  std::span<const ObservationType> known, std::vector<Outcome>& outcomes,
+                                                  const ProposalLinearization* at) const -> std::optional<FoldedProposal> {
+  FoldedProposal out{prior.mean, prior.cov, particle.log_weight, {}};
+  std::vector<FoldedMeasurement> folded;  // kept for the next linearization
   for (std::size_t i = 0; i < known.size(); ++i) {
-    if (!accepted[i]) {
-      outcomes[i] = Outcome::gated;
-      continue;
-    }
+    if (outcomes[i] != Outcome::used) continue;
     const LandmarkGaussian<M>& L = particle.landmarks[index_.at(known[i].landmark_id)];
-    auto prediction = predict_if_observable(mean, L.mean, known[i].noise_scale);
+    const State x_i = at ? at->x : out.mean;
+    auto prediction = predict_if_observable(x_i, at ? at->m[i] : Landmark(L.mean), known[i].noise_scale);
     if (!prediction) {
+      if (at) return std::nullopt;
       outcomes[i] = Outcome::unusable;
       continue;
     }
-    particle.log_weight += fold_into_proposal(mean, cov, proposal_innovation(std::move(*prediction), cov, L, known[i].z));
+    auto innovation = proposal_innovation(std::move(*prediction), out.cov, L, known[i].z);
+    if (at)
+      innovation.nu -= innovation.prediction.J_z_x * Space::minus(out.mean, x_i) +
+                       innovation.prediction.J_z_m * (L.mean - at->m[i]);
+    out.log_weight += fold_into_proposal(out.mean, out.cov, innovation);
+    if (options_.iterations > 1) folded.push_back({i, x_i, std::move(innovation)});
   }
-  if (!std::isfinite(particle.log_weight)) throw numerical_error("FastSLAM 2.0 proposal weight is not finite");
-  particle.drawn_from = std::move(mean);
-  particle.drawn_cov = std::move(cov);
-  return outcomes;
+  if (options_.iterations > 1) out.next = next_linearization(particle, known, out.mean, folded, at);
+  return out;
+}
+
+/// Where the next pass linearizes: the pass's pose x, and each landmark at its mean given x under the
+/// pass's linearization (in the linear-Gaussian joint of pose and landmarks, the landmark's posterior
+/// mean is its conditional mean at the pose's): m + Sigma_m H_m^T R^-1 (nu - H_x (x - x_i)), with
+/// R = H_m Sigma_m H_m^T + Q and nu the measurement's residual in the pass.
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::next_linearization(const Particle& particle, std::span<const ObservationType> known,
+                                                       const State& x, const std::vector<FoldedMeasurement>& folded,
+                                                       const ProposalLinearization* at) const -> ProposalLinearization {
+  ProposalLinearization next{x, std::vector<Landmark>(known.size())};
+  for (const auto& [i, x_i, innovation] : folded) {
+    const LandmarkGaussian<M>& L = particle.landmarks[index_.at(known[i].landmark_id)];
+    const auto& p = innovation.prediction;
+    Eigen::Matrix<double, Z, 1> nu = sensor_.residual(known[i].z, p.z) - p.J_z_x * Space::minus(x, x_i);
+    if (at) nu -= p.J_z_m * (L.mean - at->m[i]);
+    const auto R = cholesky_or_throw(symmetrized(p.J_z_m * L.cov * p.J_z_m.transpose() + p.Q),
+                                     "landmark innovation covariance");
+    next.m[i] = Landmark(L.mean + L.cov * p.J_z_m.transpose() * R.solve(nu));
+  }
+  return next;
 }
 
 /// A particle's pose drawn from its proposal, then each landmark its proposal used updated from the
