@@ -767,8 +767,8 @@ inline std::vector<ConfigKey> fastslam_keys() {
     {"fastslam", "seed", "1", "random seed",
      [](RunnerConfig& c, const std::string& v) { c.fastslam.seed = parse_integer<std::uint64_t>(v, 0); }},
     {"fastslam", "iterations", "1",
-     "linearizations of FastSLAM 2.0's proposal per update, each at the previous one's mean (as [ekf] iterations; "
-     "1 = the textbook proposal): docs/results/iterated_ekf.md",
+     "linearizations of FastSLAM 2.0's proposal per update, each at the previous one's pose and landmarks (as "
+     "[ekf] iterations; 1 = the textbook proposal): docs/results/iterated_ekf.md",
      [](RunnerConfig& c, const std::string& v) { c.fastslam.iterations = parse_integer<int>(v, 1, 100); }},
   };
 }

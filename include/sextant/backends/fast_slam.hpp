@@ -290,7 +290,9 @@ class FastSlam {
     const auto it = index_.find(id_of_index_[index]);
     return it != index_.end() && it->second == index;
   }
-  static std::size_t best_particle(const std::vector<Particle>& particles);
+  /// The particle with the largest weight now (the first of equal ones).
+  static std::size_t heaviest_particle(const std::vector<Particle>& particles);
+  /// The most likely particle (best_): the one whose landmarks map() lists.
   std::size_t best_particle() const { return best_; }
   std::optional<LandmarkEstimate<M>> unassociated_landmark(LandmarkId id) const;
   /// A landmark covariance in the particles' frame plus the frame's uncertainty (its translation:

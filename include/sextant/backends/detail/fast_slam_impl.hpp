@@ -515,7 +515,7 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
 template <class Motion, class Sensor, template <class> class Map>
 std::vector<std::size_t> FastSlam<Motion, Sensor, Map>::normalize_and_resample(Transaction& t) const {
   auto& particles = t.particles;
-  t.best = best_particle(particles);
+  t.best = heaviest_particle(particles);
   const double max_log = particles[t.best].log_weight;
   if (!std::isfinite(max_log)) throw numerical_error("FastSLAM particle weights are not finite");
   double sum = 0.0;
@@ -584,7 +584,7 @@ double FastSlam<Motion, Sensor, Map>::effective_sample_size_of(const std::vector
 }
 
 template <class Motion, class Sensor, template <class> class Map>
-std::size_t FastSlam<Motion, Sensor, Map>::best_particle(const std::vector<Particle>& particles) {
+std::size_t FastSlam<Motion, Sensor, Map>::heaviest_particle(const std::vector<Particle>& particles) {
   return static_cast<std::size_t>(std::max_element(particles.begin(), particles.end(),
                                                    [](const auto& a, const auto& b) { return a.log_weight < b.log_weight; }) -
                                   particles.begin());
@@ -653,7 +653,7 @@ auto FastSlam<Motion, Sensor, Map>::cloud_estimate(const std::vector<Particle>& 
   std::vector<PoseEstimate> components;
   components.reserve(cloud.size());
   for (const auto& particle : cloud) components.push_back(pose_component(particle, pending));
-  const State reference = components[best_particle(cloud)].mean;
+  const State reference = components[heaviest_particle(cloud)].mean;
   std::vector<Eigen::Matrix<double, X, 1>> d;
   for (const auto& component : components) d.push_back(Space::minus(component.mean, reference));
   const auto moments = mixture_moments<X>(w, [&](std::size_t i) { return d[i]; },
