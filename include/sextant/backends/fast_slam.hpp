@@ -64,12 +64,12 @@ struct FastSlamOptions {
   double gate_probability = 0.0;
   /// docs/results/globe.md measures both on the 12D camera.
   FastSlamLinearTail linear_tail = FastSlamLinearTail::sampled;
-  /// FastSLAM 2.0's proposal iterated (EkfOptions::iterations' Gauss-Newton, over a particle's pose
-  /// and the observed landmarks, these marginalized): up to this many linearizations of the step's
-  /// known-landmark measurements, each at the previous one's pose and the landmarks' means given it. 1 = the textbook proposal, each measurement linearized
-  /// where the ones before it moved the mean. update_unassociated folds once (its association decides
-  /// as it folds). It matters where a landmark is close to the sensor compared with the pose's spread
-  /// (docs/results/iterated_ekf.md).
+  /// FastSLAM 2.0's proposal iterated (EkfOptions::iterations' Gauss-Newton over a particle's pose
+  /// and the landmarks the step sees, these marginalized): up to this many linearizations of the
+  /// step's paired measurements, each at the previous pass's pose and the landmarks' means given it.
+  /// 1 = the textbook proposal, each measurement linearized where the ones before it moved the mean.
+  /// update_unassociated associates in the first pass and iterates what it paired. It matters where
+  /// a landmark is close to the sensor compared with the pose's spread (docs/results/iterated_ekf.md).
   int iterations = 1;
 };
 
@@ -252,17 +252,26 @@ class FastSlam {
     double log_weight;
     ProposalLinearization next;
   };
-  std::optional<FoldedProposal> fold_proposal(const Particle& particle, const PoseEstimate& prior,
-                                              std::span<const ObservationType> known, std::vector<Outcome>& outcomes,
-                                              const ProposalLinearization* at) const;
+  std::optional<FoldedProposal> fold_proposal(double log_weight, const PoseEstimate& prior,
+                                              std::span<const ObservationType> known,
+                                              std::span<const LandmarkGaussian<M>* const> landmarks,
+                                              std::vector<Outcome>& outcomes, const ProposalLinearization* at) const;
+  FoldedProposal iterated_proposal(double log_weight, const PoseEstimate& prior,
+                                   std::span<const ObservationType> observations,
+                                   std::span<const LandmarkGaussian<M>* const> landmarks,
+                                   std::vector<Outcome>& outcomes) const;
+  FoldedProposal iterated_proposal_of_matches(const Particle& particle, double log_weight, const PoseEstimate& prior,
+                                              std::span<const Measurement> measurements,
+                                              const std::vector<std::size_t>& match) const;
   /// A measurement a pass folded: its index, the pose it was linearized at, its innovation.
   struct FoldedMeasurement {
     std::size_t i;
     State x_i;
     ProposalInnovation innovation;
   };
-  ProposalLinearization next_linearization(const Particle& particle, std::span<const ObservationType> known,
-                                           const State& x, const std::vector<FoldedMeasurement>& folded,
+  ProposalLinearization next_linearization(std::span<const ObservationType> known,
+                                           std::span<const LandmarkGaussian<M>* const> landmarks, const State& x,
+                                           const std::vector<FoldedMeasurement>& folded,
                                            const ProposalLinearization* at) const;
   void draw_from_proposal(Particle& particle, std::span<const ObservationType> known, std::vector<Outcome>& outcomes,
                           std::mt19937_64& rng) const;

@@ -230,22 +230,36 @@ auto FastSlam<Motion, Sensor, Map>::propose_v2(Particle& particle, const PoseEst
                                                std::span<const ObservationType> known,
                                                const std::vector<bool>& accepted) const -> std::vector<Outcome> {
   std::vector<Outcome> outcomes(known.size(), Outcome::used);
-  for (std::size_t i = 0; i < known.size(); ++i)
+  std::vector<const LandmarkGaussian<M>*> landmarks;
+  for (std::size_t i = 0; i < known.size(); ++i) {
     if (!accepted[i]) outcomes[i] = Outcome::gated;
-  FoldedProposal proposal = *fold_proposal(particle, prior, known, outcomes, nullptr);
+    landmarks.push_back(&particle.landmarks[index_.at(known[i].landmark_id)]);
+  }
+  const FoldedProposal proposal = iterated_proposal(particle.log_weight, prior, known, landmarks, outcomes);
+  if (!std::isfinite(proposal.log_weight)) throw numerical_error("FastSLAM 2.0 proposal weight is not finite");
+  particle.log_weight = proposal.log_weight;
+  particle.drawn_from = proposal.mean;
+  particle.drawn_cov = proposal.cov;
+  return outcomes;
+}
+
+/// The proposal's first pass (fold_proposal), then options().iterations - 1 passes at most, each
+/// linearized where the last one ended, until the pose moves by less than 1e-9 of the step.
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::iterated_proposal(double log_weight, const PoseEstimate& prior,
+                                                      std::span<const ObservationType> observations,
+                                                      std::span<const LandmarkGaussian<M>* const> landmarks,
+                                                      std::vector<Outcome>& outcomes) const -> FoldedProposal {
+  FoldedProposal proposal = *fold_proposal(log_weight, prior, observations, landmarks, outcomes, nullptr);
   for (int pass = 1; pass < options_.iterations; ++pass) {
-    auto next = fold_proposal(particle, prior, known, outcomes, &proposal.next);
+    auto next = fold_proposal(log_weight, prior, observations, landmarks, outcomes, &proposal.next);
     if (!next) break;  // a measurement the model cannot predict from the iterate ends the iterations
     const double moved = Space::minus(next->mean, proposal.mean).template lpNorm<Eigen::Infinity>();
     const double step = Space::minus(next->mean, prior.mean).template lpNorm<Eigen::Infinity>();
     proposal = std::move(*next);
     if (moved <= 1e-9 * (1.0 + step)) break;
   }
-  if (!std::isfinite(proposal.log_weight)) throw numerical_error("FastSLAM 2.0 proposal weight is not finite");
-  particle.log_weight = proposal.log_weight;
-  particle.drawn_from = std::move(proposal.mean);
-  particle.drawn_cov = std::move(proposal.cov);
-  return outcomes;
+  return proposal;
 }
 
 /// One pass of the proposal: the measurements whose outcome is `used` folded one by one into the
@@ -255,15 +269,18 @@ auto FastSlam<Motion, Sensor, Map>::propose_v2(Particle& particle, const PoseEst
 /// running mean mu and the landmark's mean m: nu = z - h(x_i, m_i) - H_x (mu - x_i) - H_m (m - m_i)
 /// (nothing where the model cannot predict one). The weight starts from the particle's and gains each
 /// log N(nu; 0, S). With iterations asked for, the pass also gives the next one's linearization.
+/// Measurement i is known[i] of the landmark landmarks[i].
 template <class Motion, class Sensor, template <class> class Map>
-auto FastSlam<Motion, Sensor, Map>::fold_proposal(const Particle& particle, const PoseEstimate& prior,
-                                                  std::span<const ObservationType> known, std::vector<Outcome>& outcomes,
+auto FastSlam<Motion, Sensor, Map>::fold_proposal(double log_weight, const PoseEstimate& prior,
+                                                  std::span<const ObservationType> known,
+                                                  std::span<const LandmarkGaussian<M>* const> landmarks,
+                                                  std::vector<Outcome>& outcomes,
                                                   const ProposalLinearization* at) const -> std::optional<FoldedProposal> {
-  FoldedProposal out{prior.mean, prior.cov, particle.log_weight, {}};
+  FoldedProposal out{prior.mean, prior.cov, log_weight, {}};
   std::vector<FoldedMeasurement> folded;  // kept for the next linearization
   for (std::size_t i = 0; i < known.size(); ++i) {
     if (outcomes[i] != Outcome::used) continue;
-    const LandmarkGaussian<M>& L = particle.landmarks[index_.at(known[i].landmark_id)];
+    const LandmarkGaussian<M>& L = *landmarks[i];
     const State x_i = at ? at->x : out.mean;
     auto prediction = predict_if_observable(x_i, at ? at->m[i] : Landmark(L.mean), known[i].noise_scale);
     if (!prediction) {
@@ -278,7 +295,7 @@ auto FastSlam<Motion, Sensor, Map>::fold_proposal(const Particle& particle, cons
     out.log_weight += fold_into_proposal(out.mean, out.cov, innovation);
     if (options_.iterations > 1) folded.push_back({i, x_i, std::move(innovation)});
   }
-  if (options_.iterations > 1) out.next = next_linearization(particle, known, out.mean, folded, at);
+  if (options_.iterations > 1) out.next = next_linearization(known, landmarks, out.mean, folded, at);
   return out;
 }
 
@@ -287,12 +304,13 @@ auto FastSlam<Motion, Sensor, Map>::fold_proposal(const Particle& particle, cons
 /// mean is its conditional mean at the pose's): m + Sigma_m H_m^T R^-1 (nu - H_x (x - x_i)), with
 /// R = H_m Sigma_m H_m^T + Q and nu the measurement's residual in the pass.
 template <class Motion, class Sensor, template <class> class Map>
-auto FastSlam<Motion, Sensor, Map>::next_linearization(const Particle& particle, std::span<const ObservationType> known,
+auto FastSlam<Motion, Sensor, Map>::next_linearization(std::span<const ObservationType> known,
+                                                       std::span<const LandmarkGaussian<M>* const> landmarks,
                                                        const State& x, const std::vector<FoldedMeasurement>& folded,
                                                        const ProposalLinearization* at) const -> ProposalLinearization {
   ProposalLinearization next{x, std::vector<Landmark>(known.size())};
   for (const auto& [i, x_i, innovation] : folded) {
-    const LandmarkGaussian<M>& L = particle.landmarks[index_.at(known[i].landmark_id)];
+    const LandmarkGaussian<M>& L = *landmarks[i];
     const auto& p = innovation.prediction;
     Eigen::Matrix<double, Z, 1> nu = sensor_.residual(known[i].z, p.z) - p.J_z_x * Space::minus(x, x_i);
     if (at) nu -= p.J_z_m * (L.mean - at->m[i]);
@@ -787,16 +805,41 @@ std::vector<std::size_t> FastSlam<Motion, Sensor, Map>::associate_and_propose(
   PoseEstimate prior{particle.x, particle.cov};
   for (const auto& motion : pending) prior = motion_gaussian(prior.mean, prior.cov, motion.u, motion.dt);
   auto [mean, cov] = prior;
+  const double log_weight = particle.log_weight;
   const auto match = associate_in_particle(particle, mean, cov, measurements, proposal);
   if (!proposal) {
     particle.forget_proposal();
     return match;
+  }
+  if (options_.iterations > 1) {  // the associated measurements' proposal iterated as update()'s
+    auto folded = iterated_proposal_of_matches(particle, log_weight, prior, measurements, match);
+    mean = std::move(folded.mean), cov = std::move(folded.cov), particle.log_weight = folded.log_weight;
   }
   for (std::size_t i = 0; i < measurements.size(); ++i)
     if (match[i] == kNewLandmark) particle.log_weight += new_landmark_log_weight(mean, measurements[i]);
   particle.drawn_from = std::move(mean);
   particle.drawn_cov = std::move(cov);
   return match;
+}
+
+/// The proposal of the measurements `match` pairs with landmarks of `particle`, iterated from the
+/// particle's weight before them (the first pass repeats the association's folding).
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::iterated_proposal_of_matches(const Particle& particle, double log_weight,
+                                                                 const PoseEstimate& prior,
+                                                                 std::span<const Measurement> measurements,
+                                                                 const std::vector<std::size_t>& match) const
+    -> FoldedProposal {
+  std::vector<ObservationType> paired(measurements.size());
+  std::vector<const LandmarkGaussian<M>*> landmarks(measurements.size(), nullptr);
+  std::vector<Outcome> outcomes(measurements.size(), Outcome::gated);
+  for (std::size_t i = 0; i < measurements.size(); ++i) {
+    paired[i].z = measurements[i];
+    if (match[i] == kNewLandmark) continue;
+    landmarks[i] = &particle.unassociated[match[i]];
+    outcomes[i] = Outcome::used;
+  }
+  return iterated_proposal(log_weight, prior, paired, landmarks, outcomes);
 }
 
 /// log N(0; 0, Q) - new_landmark_nis / 2: what a new landmark weighs, as a measurement on the
