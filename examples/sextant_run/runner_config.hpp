@@ -537,7 +537,8 @@ inline std::vector<ConfigKey> mrclam_keys() {
      "MRCLAM: Mahalanobis gate of EKF and SEIF (real data has outliers; 0 = off); overrides their own (FastSLAM keeps [fastslam]'s)",
      [](RunnerConfig& c, const std::string& v) { c.mrclam_gate_probability = parse_gate_probability(v); }},
     {"mrclam", "reacquire_after_landmarks", "3",
-     "MRCLAM: the EKF re-acquires a pose lost beyond its covariance (with the gate on; 0 = never); overrides [ekf]",
+     "MRCLAM: EKF and SEIF re-acquire a pose lost beyond their covariance (with the gate on; 0 = never); overrides "
+     "[ekf] and [seif]",
      [](RunnerConfig& c, const std::string& v) { c.mrclam_reacquire_after_landmarks = parse_integer<int>(v, 0, 1e6); }},
     {"mrclam", "graph_robust_kernel", "cauchy", "MRCLAM: GraphSLAM's robust kernel (none | huber | cauchy); overrides [graph]",
      [](RunnerConfig& c, const std::string& v) {
@@ -617,7 +618,8 @@ inline std::vector<ConfigKey> ekf_keys() {
 }
 
 /// [seif]: SEIF-SLAM's options.
-inline std::vector<ConfigKey> seif_keys() {
+/// SEIF's chart, gate and re-acquisition (the keys before seif_keys()).
+inline std::vector<ConfigKey> seif_robustness_keys() {
   return {
     {"seif", "first_estimate_jacobians", "auto",
      "auto (on where the pose is perturbed in the world frame: MRCLAM) | true | false",
@@ -628,6 +630,15 @@ inline std::vector<ConfigKey> seif_keys() {
     {"seif", "gate_probability", "0",
      "Mahalanobis gate with the exact marginals (one factorization per update); 0 = off",
      [](RunnerConfig& c, const std::string& v) { c.seif.gate_probability = parse_gate_probability(v); }},
+    {"seif", "reacquire_after_landmarks", "0",
+     "with the gate on: as [ekf] reacquire_after_landmarks, with the library's drift factor (5) and probation (20); "
+     "0 = keep rejecting",
+     [](RunnerConfig& c, const std::string& v) { c.seif.reacquisition.min_landmarks = parse_integer<int>(v, 0, 1e6); }},
+  };
+}
+
+inline std::vector<ConfigKey> seif_keys() {
+  return {
     {"seif", "max_active", "8", "landmarks kept linked to the robot by sparsification; 0 = no sparsification",
      [](RunnerConfig& c, const std::string& v) { c.seif.max_active = parse_integer<std::size_t>(v, 0, 1e6); }},
     {"seif", "sparsification", "thesis",
@@ -790,8 +801,8 @@ inline const std::vector<ConfigKey>& config_keys() {
     for (const auto& section : {detail::ship_keys(), detail::globe_keys(), detail::globe_stereo_keys(),
                                 detail::globe_stereo_association_keys(), detail::globe_graph_keys(),
                                 detail::vislam_keys(), detail::rawlog_keys(), detail::mrclam_keys(),
-                                detail::association_keys(), detail::ekf_keys(), detail::seif_keys(),
-                                detail::graph_keys(), detail::pose_graph_keys(), detail::fastslam_keys(),
+                                detail::association_keys(), detail::ekf_keys(), detail::seif_robustness_keys(),
+                                detail::seif_keys(), detail::graph_keys(), detail::pose_graph_keys(), detail::fastslam_keys(),
                                 detail::scene_keys()})
       all.insert(all.end(), section.begin(), section.end());
     return all;

@@ -234,32 +234,51 @@ struct StressRun {
   double worst_eigenvalue_ratio = 1.0;
 };
 
+/// A filter run over the data; a failed update is counted and the run goes on. `after_step` sees
+/// the filter after each step.
+template <class Filter, class AfterStep>
+StressRun stress_run(Filter& filter, const io::MrclamRun& data, double scored_from, AfterStep after_step) {
+  StressRun out;
+  std::vector<Eigen::Vector2d> estimate, truth;
+  for (std::size_t k = 0; k < data.steps.size(); ++k) {
+    filter.predict(data.steps[k].control, data.steps[k].dt);
+    try {
+      filter.update(data.steps[k].observations);
+    } catch (const error&) {
+      ++out.failed_updates;
+    }
+    after_step(filter, out);
+    if (data.step_times[k] < scored_from) continue;
+    estimate.push_back(filter.pose().mean.template head<2>());
+    truth.push_back(data.true_poses[k + 1].head<2>());
+  }
+  out.aligned_rmse = eval::rms(eval::aligned_errors<2>(estimate, truth));
+  return out;
+}
+
 /// The EKF as sextant-run runs it on MRCLAM (world chart, first estimates, 0.9999 gate), with P's
-/// spectrum checked after every step; a failed update is counted and the run goes on.
+/// spectrum checked after every step.
 StressRun world_ekf_stress_run(const io::MrclamRun& data, double scored_from, bool reacquire = true) {
   using WorldMotion = InWorldFrame<Unicycle>;
   using WorldSensor = SeenInWorldFrame<RangeBearing2D>;
   EkfOptions options{.gate_probability = 0.9999, .first_estimate_jacobians = true};
   options.reacquisition.min_landmarks = reacquire ? 3 : 0;  // 3: as sextant-run's MRCLAM family
   EkfSlam<WorldMotion, WorldSensor> ekf(WorldMotion(data.motion), WorldSensor(data.sensor), in_world_frame(data.prior), options);
-  StressRun out;
-  std::vector<Eigen::Vector2d> estimate, truth;
-  for (std::size_t k = 0; k < data.steps.size(); ++k) {
-    ekf.predict(data.steps[k].control, data.steps[k].dt);
-    try {
-      ekf.update(data.steps[k].observations);
-    } catch (const error&) {
-      ++out.failed_updates;
-    }
+  return stress_run(ekf, data, scored_from, [](const auto& filter, StressRun& out) {
     const Eigen::VectorXd eigenvalues =
-        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(ekf.covariance(), Eigen::EigenvaluesOnly).eigenvalues();
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(filter.covariance(), Eigen::EigenvaluesOnly).eigenvalues();
     out.worst_eigenvalue_ratio = std::min(out.worst_eigenvalue_ratio, eigenvalues.minCoeff() / eigenvalues.maxCoeff());
-    if (data.step_times[k] < scored_from) continue;
-    estimate.push_back(ekf.pose().mean.head<2>());
-    truth.push_back(data.true_poses[k + 1].head<2>());
-  }
-  out.aligned_rmse = eval::rms(eval::aligned_errors<2>(estimate, truth));
-  return out;
+  });
+}
+
+/// SEIF as sextant-run runs it on MRCLAM (8 active, world chart, first estimates, 0.9999 gate).
+StressRun world_seif_stress_run(const io::MrclamRun& data, double scored_from, bool reacquire) {
+  using WorldMotion = InWorldFrame<Unicycle>;
+  using WorldSensor = SeenInWorldFrame<RangeBearing2D>;
+  SeifOptions options{.max_active = 8, .gate_probability = 0.9999, .first_estimate_jacobians = true};
+  options.reacquisition.min_landmarks = reacquire ? 3 : 0;
+  SeifSlam<WorldMotion, WorldSensor> seif(WorldMotion(data.motion), WorldSensor(data.sensor), in_world_frame(data.prior), options);
+  return stress_run(seif, data, scored_from, [](const auto&, StressRun&) {});
 }
 
 /// Issue 35's stress cases, built from Dataset6.
@@ -326,6 +345,29 @@ TEST(PlanarFirstEstimates, OnMrclamTheWorldFrameEkfSurvivesOutlierBurstsWrongFir
                                                         world_ekf_stress_run(data, gap.scored_from, false).aligned_rmse);
   }
   EXPECT_GT(worst_gap_without, 2.0) << "without re-acquisition the gap is a failure on some robot";
+}
+
+/// SEIF re-acquires a lost pose with the EKF's machinery (core/lost_pose_recovery.hpp): the minute
+/// without sightings of the test above leaves SEIF within 2x of its clean run on every robot (issue
+/// 35's bound), where without re-acquisition the gate rejects the returning sightings and some robot
+/// fails. Measured 2026-12-05: see the printout and docs/results/mrclam.md.
+TEST(PlanarFirstEstimates, OnMrclamTheWorldFrameSeifReacquiresAPoseLostInAGap) {
+  const std::string dir = test::shared_data("mrclam/MRCLAM_Dataset6");
+  SEXTANT_REQUIRE_DATA(dir);
+  double worst_without = 0.0;
+  for (int robot = 1; robot <= 5; ++robot) {
+    const auto data = io::read_mrclam(dir, robot, {.odometry_delay = 0.2});
+    const auto gap = with_sightings_removed(data, 300.0, 360.0);
+    const StressRun clean = world_seif_stress_run(data, 390.0, true), run = world_seif_stress_run(gap, 390.0, true);
+    const double without = world_seif_stress_run(gap, 390.0, false).aligned_rmse /
+                           world_seif_stress_run(data, 390.0, false).aligned_rmse;
+    EXPECT_EQ(run.failed_updates, 0u) << "robot " << robot;
+    EXPECT_LE(run.aligned_rmse, 2.0 * clean.aligned_rmse) << "robot " << robot;
+    std::printf("robot %d: SEIF after the gap, aligned RMSE %.3f m, clean %.3f m (%.2fx; without re-acquisition %.2fx)\n",
+                robot, run.aligned_rmse, clean.aligned_rmse, run.aligned_rmse / clean.aligned_rmse, without);
+    worst_without = std::max(worst_without, without);
+  }
+  EXPECT_GT(worst_without, 2.0) << "without re-acquisition the gap is a failure on some robot";
 }
 
 /// CircleRun with steps [from, to) without sightings, during which the odometry reports `bias`

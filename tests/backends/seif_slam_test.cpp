@@ -67,6 +67,44 @@ TEST(SeifSlam, WithoutSparsificationEqualsEkfOverTheWholeShipRun) {
   RecordProperty("worst_relative_covariance_difference", std::to_string(worst_cov));
 }
 
+/// Re-acquisition's move of a lost pose (core/lost_pose_recovery.hpp) is EkfSlam::reacquire_pose in
+/// information form: the mean moved by d, d d^T added to the robot's covariance and nothing else,
+/// which the motion update with G = I and R = d d^T gives. Without sparsification SEIF then holds the
+/// EKF's pose and map, and keeps holding them over the steps after; an offset with NaN throws and
+/// leaves SEIF as it was.
+TEST(SeifSlam, ReacquiringAPoseIsTheEkfsMoveInInformationForm) {
+  const auto data = sim::simulate_ship_2d({.seed = 5});
+  Ekf ekf{data.motion, data.sensor, data.prior};
+  Seif seif{data.motion, data.sensor, data.prior, {.max_active = 0, .exact_recovery_period = 1}};
+  for (std::size_t k = 0; k < 300; ++k) step_both(ekf, seif, data.steps[k]);
+  const Eigen::Vector2d d(30.0, -20.0);  // km: a few of the pose's standard deviations
+  ekf.reacquire_pose(d);
+  const Eigen::SparseMatrix<double> information = seif.information_matrix();
+  const Eigen::Vector2d before = seif.pose_mean();
+  EXPECT_THROW(seif.reacquire_pose(Eigen::Vector2d(std::nan(""), 0.0)), invalid_input_error);
+  EXPECT_EQ((seif.information_matrix() - information).norm(), 0.0);
+  EXPECT_EQ(seif.pose_mean(), before);
+  seif.reacquire_pose(d);
+  seif.recover_mean_exactly();
+  auto worst = [&] {
+    double mean = (ekf.pose().mean - seif.pose().mean).cwiseAbs().maxCoeff();
+    double cov = max_relative_difference(seif.pose().cov, ekf.pose().cov);
+    for (const auto& landmark : ekf.map()) {
+      const auto other = seif.landmark(landmark.id);
+      mean = std::max(mean, (landmark.mean - other.mean).cwiseAbs().maxCoeff());
+      cov = std::max(cov, max_relative_difference(other.cov, landmark.cov));
+    }
+    return std::pair{mean, cov};
+  };
+  const auto [mean_at_move, cov_at_move] = worst();
+  EXPECT_LT(mean_at_move, 1e-6);
+  EXPECT_LT(cov_at_move, 1e-6);
+  for (std::size_t k = 300; k < 400; ++k) step_both(ekf, seif, data.steps[k]);
+  const auto [mean_after, cov_after] = worst();
+  EXPECT_LT(mean_after, 1e-6);
+  EXPECT_LT(cov_after, 1e-6);
+}
+
 TEST(SeifSlam, LinearGaussianProblemEqualsExactBatchLeastSquares) {
   const auto& motion = test::kLinearMotion;
   const auto& sensor = test::kLinearSensor;

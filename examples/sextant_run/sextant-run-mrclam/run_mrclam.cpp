@@ -101,7 +101,8 @@ std::pair<std::vector<BackendKind>, std::vector<BackendKind>> split_filters(cons
 /// and a gate on it rejects the sightings that would bring a drifted cloud back (docs/results/mrclam.md).
 RunnerConfig with_mrclam_robustness(RunnerConfig c) {
   c.ekf.gate_probability = c.seif.gate_probability = c.mrclam_gate_probability;
-  c.ekf.reacquisition.min_landmarks = c.mrclam_gate_probability > 0.0 ? c.mrclam_reacquire_after_landmarks : 0;
+  c.ekf.reacquisition.min_landmarks = c.seif.reacquisition.min_landmarks =
+      c.mrclam_gate_probability > 0.0 ? c.mrclam_reacquire_after_landmarks : 0;
   c.graph.measurement_loss.kernel = c.mrclam_graph_kernel;
   return c;
 }

@@ -14,7 +14,7 @@
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/filter_linearization.hpp"
 #include "sextant/core/observability_constraints.hpp"
-#include "sextant/core/pose_reacquisition.hpp"
+#include "sextant/core/lost_pose_recovery.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/innovation_gate.hpp"
 #include "sextant/core/joint_marginal.hpp"
@@ -195,10 +195,10 @@ class EkfSlam {
   /// update() without re-acquisition: the EKF's correction and augmentation (eqs. 14-17).
   UpdateResult correct_and_augment(std::span<const ObservationType> observations);
   using Reacquisition = PoseReacquisition<Space, Sensor, State, X>;
-  /// After a committed update: the record of rejections, the probation, the switch to its candidate.
-  void follow_up_reacquisition(std::span<const ObservationType> observations, UpdateResult& result);
-  void start_probation(const Eigen::Matrix<double, X, 1>& d);
-  void end_probation_if_over(double candidate_log_likelihood, UpdateResult& result);
+  using Recovery = LostPoseRecovery<EkfSlam, Reacquisition>;
+  friend Recovery;
+  /// A candidate that won its probation: its estimate replaces this one's.
+  void adopt_estimate(EkfSlam&& candidate);
   std::vector<typename Reacquisition::Sighting> rejected_sightings(std::span<const ObservationType> observations,
                                                                    const UpdateResult& result) const;
   void commit(const Plan& plan);
@@ -215,8 +215,7 @@ class EkfSlam {
   State propagated_;  ///< the robot state after the last prediction (observability constraints)
   LandmarkStore<M> landmarks_;  ///< ids, slots, means and first means (first_estimate_jacobians)
   GrowableSquareMatrix cov_;     ///< P; only its lower triangle is kept up to date
-  Reacquisition reacquisition_;  ///< the gate's rejections since the last accepted sighting
-  PoseProbation<EkfSlam> probation_;  ///< a copy moved to where the rejections say the pose is
+  Recovery recovery_;  ///< re-acquisition of a lost pose (off unless options_.reacquisition says)
 };
 
 }  // namespace sextant

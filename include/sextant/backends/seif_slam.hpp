@@ -24,6 +24,7 @@
 #include "sextant/core/joint_marginal.hpp"
 #include "sextant/core/landmark_pool.hpp"
 #include "sextant/core/linearized_observation.hpp"
+#include "sextant/core/lost_pose_recovery.hpp"
 #include "sextant/core/sparse_cholesky.hpp"
 #include "sextant/core/slot_set.hpp"
 #include "sextant/core/sparse_information.hpp"
@@ -119,6 +120,10 @@ struct SeifOptions {
   /// iterated before the robot is marginalized, so the held-back measurements relocalize it from the
   /// step's mean. Each iteration costs one more mean recovery.
   int iterations = 1;
+  /// With the gate on: re-acquisition of a lost pose, as EkfOptions::reacquisition (the same
+  /// machinery, core/lost_pose_recovery.hpp); the moved copy's pose covariance grows by d d^T as a
+  /// motion update with G = I and R = d d^T would grow it. min_landmarks = 0 (the default): off.
+  ReacquisitionOptions reacquisition{};
 };
 
 /// Wall time of one update's stages, as the thesis times them (§5.4, Tables 15-16): measurement
@@ -157,6 +162,12 @@ class SeifSlam {
   /// repeated ids, non-PD noise) throws before anything changes.
   UpdateResult update(std::span<const ObservationType> observations);
   UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }
+
+  /// Moves the robot's mean by d (Space::plus) and adds d d^T to its covariance, as
+  /// EkfSlam::reacquire_pose: in information form the motion update with G = I and R = d d^T, which
+  /// changes the robot's and the active landmarks' blocks only. Throws invalid_input_error on a d
+  /// that is not finite; the state is then unchanged.
+  void reacquire_pose(const Eigen::Matrix<double, X, 1>& d);
 
   /// A landmark known before it is seen (a surveyed map), with its mean and covariance, uncorrelated
   /// with the robot and the map: its information block is cov^-1 and it has no link (it is not active),
@@ -252,7 +263,18 @@ class SeifSlam {
   /// Nothing when the model cannot use the observation here (its id then goes to `unusable`).
   std::optional<Linearized> linearize(const ObservationType& observation, std::vector<LandmarkId>& unusable) const;
   MeasurementInformation measurement_information(const Linearized& lin) const;
-  void gate(std::vector<Linearized>& observations, std::vector<LandmarkId>& rejected) const;
+  void gate(std::vector<Linearized>& observations, UpdateResult& result) const;
+  /// The motion update (eqs. 20-26) from the robot's transition G and noise R to the moved mean.
+  void apply_motion(const State& moved, const Eigen::Matrix<double, X, X>& G, const Eigen::Matrix<double, X, X>& R);
+  /// update() without re-acquisition.
+  UpdateResult update_information(std::span<const ObservationType> observations);
+  using Reacquisition = PoseReacquisition<Space, Sensor, State, X>;
+  using Recovery = LostPoseRecovery<SeifSlam, Reacquisition>;
+  friend Recovery;
+  /// A candidate that won its probation: its estimate replaces this one's.
+  void adopt_estimate(SeifSlam&& candidate);
+  std::vector<typename Reacquisition::Sighting> rejected_sightings(std::span<const ObservationType> observations,
+                                                                   const UpdateResult& result) const;
   std::optional<NewLandmark> new_landmark(const ObservationType& observation, std::vector<LandmarkId>& unusable) const;
   /// The linear factor `info`, linearized at the current mean, added to the information form.
   void add(const MeasurementInformation& info);
@@ -390,6 +412,7 @@ class SeifSlam {
   SlotSet marked_slots_;  ///< mark_slots' slots (scratch)
   /// The landmarks outside a recovered block whose residual this update's recoveries changed (scratch).
   SlotSet changed_residuals_;
+  Recovery recovery_;  ///< re-acquisition of a lost pose (off unless options_.reacquisition says)
 };
 
 }  // namespace sextant

@@ -17,9 +17,10 @@ struct UpdateResult {
   /// smallest for a new landmark), skipped one by one; a new landmark listed here is not added.
   std::vector<LandmarkId> unusable;
   /// The pose had been lost: a copy moved to where the gate's rejected sightings put it explained
-  /// the sightings since better, and replaced the estimate (EKF-SLAM, core/pose_reacquisition.hpp).
+  /// the sightings since better, and replaced the estimate (EKF-SLAM and SEIF-SLAM,
+  /// core/lost_pose_recovery.hpp).
   bool pose_reacquired = false;
-  /// With the gate on (EKF-SLAM): the predictive log-likelihood of the sightings of known landmarks,
+  /// With the gate on (EKF-SLAM, SEIF-SLAM): the predictive log-likelihood of the sightings of known landmarks,
   /// sum of -(min(NIS, gate) + log det S + Z log 2 pi) / 2: a rejected sighting counts as one on the
   /// gate's edge. Two hypotheses about the pose are compared by it (core/pose_reacquisition.hpp).
   double log_likelihood = 0.0;

@@ -22,7 +22,7 @@ EkfSlam<Motion, Sensor>::EkfSlam(Motion motion, Sensor sensor, const PoseEstimat
     throw invalid_input_error("EkfOptions::iterations must be at least 1 (got " + std::to_string(options_.iterations) + ")");
   gate_ = InnovationGate(Z, options_.gate_probability);
   if (options_.reacquisition.min_landmarks != 0)  // checks the options; needs the gate
-    reacquisition_ = Reacquisition(options_.reacquisition, options_.gate_probability);
+    recovery_ = Recovery(options_.reacquisition, options_.gate_probability);
   cov_.view() = symmetrized(prior.cov);
 }
 
@@ -40,19 +40,13 @@ void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
   const Eigen::Matrix<double, X, X> P_xx = symmetrized(G * symmetric_diagonal_block<X>(P, 0) * G.transpose() + prediction.R);
   const Eigen::MatrixXd P_mx = P.bottomLeftCorner(rest, X) * G.transpose();
   if (!P_xx.allFinite() || !P_mx.allFinite()) throw numerical_error("EKF motion update overflowed (NaN or Inf)");
-  const auto drift = reacquisition_.drift_after(G, prediction.R);
+  const auto drift = recovery_.drift_after(G, prediction.R);
   P.template topLeftCorner<X, X>() = P_xx;
   P.bottomLeftCorner(rest, X) = P_mx;
   x_ = prediction.x;
   propagated_ = prediction.x;
-  reacquisition_.set_drift(drift);
-  if (probation_.active()) {  // the candidate follows; one that cannot is dropped
-    try {
-      probation_.candidate().predict(u, dt);
-    } catch (const error&) {
-      probation_.drop();
-    }
-  }
+  recovery_.set_drift(drift);
+  recovery_.follow([&](EkfSlam& candidate) { candidate.predict(u, dt); });
 }
 
 
@@ -60,7 +54,7 @@ void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
 template <class Motion, class Sensor>
 UpdateResult EkfSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
   UpdateResult result = correct_and_augment(observations);
-  follow_up_reacquisition(observations, result);
+  if (auto winner = recovery_.follow_up(*this, observations, result)) adopt_estimate(std::move(*winner));
   return result;
 }
 
@@ -337,7 +331,7 @@ void EkfSlam<Motion, Sensor>::augment(LandmarkId id, const Init& init) {
 template <class Motion, class Sensor>
 void EkfSlam<Motion, Sensor>::add_landmark(const LandmarkEstimate<M>& known) {
   require_valid_known_landmark(known, landmarks_.contains(known.id));
-  if (probation_.active()) probation_.candidate().add_landmark(known);  // checked above: cannot throw but bad_alloc
+  recovery_.follow([&](EkfSlam& candidate) { candidate.add_landmark(known); });  // checked above
   const Eigen::Index offset = cov_.dim();
   landmarks_.add(known.id, Landmark(known.mean));
   cov_.grow(M);  // zero cross-covariance with the robot and the map
@@ -351,13 +345,7 @@ void EkfSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
   auto P = cov_.view();
   mirror_lower_to_upper(P);  // the move below reads whole rows and columns
   cov_.remove_block_by_moving_last(offset_of(removal.freed_slot), M);
-  if (probation_.active()) {  // the candidate follows; one that cannot is dropped
-    try {
-      probation_.candidate().remove_landmark(id);
-    } catch (const error&) {
-      probation_.drop();
-    }
-  }
+  recovery_.follow([&](EkfSlam& candidate) { candidate.remove_landmark(id); });
 }
 
 template <class Motion, class Sensor>

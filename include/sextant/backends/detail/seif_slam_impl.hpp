@@ -36,6 +36,8 @@ SeifSlam<Motion, Sensor>::SeifSlam(Motion motion, Sensor sensor, const PoseEstim
     throw invalid_input_error("SeifOptions: stale_mean_probability must be in [0, 1) (0 = off)");
   if (options_.stale_mean_probability > 0.0) stale_gate_ = chi_square_quantile(M, options_.stale_mean_probability);
   if (options_.sparsification == SeifSparsification::relocalization) tail_information_ = relocalized_tail_information(prior);
+  if (options_.reacquisition.min_landmarks != 0)  // checks the options; needs the gate
+    recovery_ = Recovery(options_.reacquisition, options_.gate_probability);
 }
 
 /// The information of the relocalized tail: SeifOptions::relocalization_tail_covariance inverted, or
@@ -67,20 +69,39 @@ Eigen::MatrixXd SeifSlam<Motion, Sensor>::relocalized_tail_information(const Pos
 /// (and Omega indefinite) when R is large against Phi_xx^-1, e.g. after a long dt.
 template <class Motion, class Sensor>
 void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
-  using MatrixX = Eigen::Matrix<double, X, X>;
   require_finite(u, "control");
   require_positive_time_step(dt);
   const auto prediction = checked_motion_prediction(motion_, x_, u, dt);
-  const MatrixX G =
+  const Eigen::Matrix<double, X, X> G =
       robot_transition<Space, X>(options_.observability_constraints, prediction.J_x_x, propagated_, prediction.x);
+  const auto drift = recovery_.drift_after(G, prediction.R);
+  apply_motion(prediction.x, G, prediction.R);
+  propagated_ = prediction.x;
+  recovery_.set_drift(drift);
+  recovery_.follow([&](SeifSlam& candidate) { candidate.predict(u, dt); });
+}
+
+/// As EkfSlam::reacquire_pose: Sigma_xx += d d^T with the mean moved by d, the motion update with
+/// G = I and R = d d^T (its T needs no R^-1).
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::reacquire_pose(const Eigen::Matrix<double, X, 1>& d) {
+  if (!d.allFinite()) throw invalid_input_error("reacquire_pose: the offset contains NaN or Inf");
+  const State moved = Space::plus(x_, d);
+  if (!Space::is_finite(moved)) throw numerical_error("reacquire_pose: the moved pose is not finite");
+  apply_motion(moved, Eigen::Matrix<double, X, X>::Identity(), d * d.transpose());
+}
+
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::apply_motion(const State& moved, const Eigen::Matrix<double, X, X>& G,
+                                            const Eigen::Matrix<double, X, X>& R) {
+  using MatrixX = Eigen::Matrix<double, X, X>;
   const auto singular_values = Eigen::JacobiSVD<MatrixX>(G).singularValues();
   if (!(singular_values(X - 1) > 1e-12 * singular_values(0)))
     throw numerical_error("motion Jacobian G is singular; the SEIF motion update needs G^-1");
   const MatrixX G_inv_T = G.partialPivLu().solve(MatrixX::Identity()).transpose();  // conditioning checked above
   const MatrixX Phi_xx = symmetrized(G_inv_T * info_.robot() * G_inv_T.transpose());
-  const MatrixX T = symmetrized(
-      (MatrixX::Identity() + prediction.R * Phi_xx).partialPivLu().solve(prediction.R));
-  const MatrixX A = (MatrixX::Identity() + Phi_xx * prediction.R).partialPivLu().solve(MatrixX::Identity());
+  const MatrixX T = symmetrized((MatrixX::Identity() + R * Phi_xx).partialPivLu().solve(R));
+  const MatrixX A = (MatrixX::Identity() + Phi_xx * R).partialPivLu().solve(MatrixX::Identity());
   std::vector<std::size_t> active;  // the active landmarks, in the order of Phi_xA's columns
   Eigen::MatrixXd Phi_xA(X, M * static_cast<Eigen::Index>(info_.robot_links().size()));
   for (const auto& [slot, block] : info_.robot_links()) {
@@ -111,12 +132,11 @@ void SeifSlam<Motion, Sensor>::predict(const Control& u, double dt) {
         [&](std::size_t a, std::size_t b, const Eigen::Matrix<double, M, M>& block) {
           D.template block<M, M>(X + at(a), X + at(b)) = block;
         });
-    x_ = prediction.x;
+    x_ = moved;
     require_finite_robot_and_active("SEIF motion update");
     fill_robot_and_diagonal_blocks(active, D);
     require_factorizable_block(D, "SEIF motion update");
   });
-  propagated_ = prediction.x;
 }
 
 /// One observation linearized at the current estimate (H at the first estimate if so configured).
@@ -204,8 +224,16 @@ std::vector<std::size_t> SeifSlam<Motion, Sensor>::add_step(const std::vector<Me
   return observed;
 }
 
+/// The update, then (when on) the re-acquisition's bookkeeping, which cannot throw.
 template <class Motion, class Sensor>
 UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
+  UpdateResult result = update_information(observations);
+  if (auto winner = recovery_.follow_up(*this, observations, result)) adopt_estimate(std::move(*winner));
+  return result;
+}
+
+template <class Motion, class Sensor>
+UpdateResult SeifSlam<Motion, Sensor>::update_information(std::span<const ObservationType> observations) {
   using Clock = std::chrono::steady_clock;
   const auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   auto stage_start = Clock::now();
@@ -220,7 +248,7 @@ UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> o
   UpdateResult result;
   for (const auto& observation : known)
     if (auto lin = linearize(observation, result.unusable)) linearized.push_back(std::move(*lin));
-  gate(linearized, result.rejected);
+  gate(linearized, result);
   result.corrected = linearized.size();
   std::vector<MeasurementInformation> measurements;
   measurements.reserve(linearized.size());
@@ -336,7 +364,7 @@ void SeifSlam<Motion, Sensor>::iterate_before_relocalizing(std::span<const Obser
 /// Removes the observations whose innovation fails the chi-square test, with S = H Sigma H^T + Q and
 /// Sigma the joint marginal of the robot and the landmark: one multi-column solve with the factor of Omega.
 template <class Motion, class Sensor>
-void SeifSlam<Motion, Sensor>::gate(std::vector<Linearized>& observations, std::vector<LandmarkId>& rejected) const {
+void SeifSlam<Motion, Sensor>::gate(std::vector<Linearized>& observations, UpdateResult& result) const {
   if (!gate_.on() || observations.empty()) return;
   std::vector<Eigen::Index> offsets;
   for (const Linearized& lin : observations) offsets.push_back(lin.offset);
@@ -348,8 +376,10 @@ void SeifSlam<Motion, Sensor>::gate(std::vector<Linearized>& observations, std::
     const Eigen::Matrix<double, Z, Z> S =
         symmetrized(innovation_cross_block(joint, lin.J_z_x, lin.J_z_m, at, lin.J_z_x, lin.J_z_m, at) + lin.Q);
     const auto llt = cholesky_or_throw(S, "innovation covariance of landmark " + std::to_string(lin.id));
-    if (gate_.rejects(llt, lin.residual))
-      rejected.push_back(lin.id);
+    const double nis = mahalanobis_squared(llt, lin.residual);
+    result.log_likelihood += gated_log_likelihood(gate_, llt, nis);
+    if (gate_.rejects(nis))
+      result.rejected.push_back(lin.id);
     else
       kept.push_back(lin);
   }
@@ -862,6 +892,7 @@ void SeifSlam<Motion, Sensor>::add_landmark(const LandmarkEstimate<M>& known) {
   const Eigen::Matrix<double, M, M> information = inverse_from_cholesky(known.cov.llt());
   if (!information.allFinite())
     throw numerical_error("known landmark " + std::to_string(known.id) + ": its information (covariance inverse) is not finite");
+  recovery_.follow([&](SeifSlam& candidate) { candidate.add_landmark(known); });  // checked above
   atomically([&] {
     const std::size_t slot = landmarks_.add(known.id, Landmark(known.mean));
     info_.append_landmark();
@@ -880,6 +911,7 @@ void SeifSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
   active_queue_ = std::move(queue);
   update_active_queue({});
   touch();
+  recovery_.follow([&](SeifSlam& candidate) { candidate.remove_landmark(id); });
 }
 
 template <class Motion, class Sensor>
@@ -999,6 +1031,43 @@ template <class Motion, class Sensor>
 std::vector<LandmarkId> SeifSlam<Motion, Sensor>::active_landmarks() const {
   std::vector<LandmarkId> out;
   for (std::size_t slot : active_queue_) out.push_back(landmarks_.id_at(slot));
+  return out;
+}
+
+/// Everything but the re-acquisition's own record, which stays this filter's.
+template <class Motion, class Sensor>
+void SeifSlam<Motion, Sensor>::adopt_estimate(SeifSlam&& candidate) {
+  Recovery recovery = std::move(recovery_);
+  *this = std::move(candidate);
+  recovery_ = std::move(recovery);
+}
+
+/// The update's rejected sightings as the re-acquisition test reads them: each with the robot's
+/// mean, the landmark's and S = J_m P_m J_m^T + Q, P_m the landmark's marginal (one solve for all).
+/// One the model cannot predict is left out.
+template <class Motion, class Sensor>
+auto SeifSlam<Motion, Sensor>::rejected_sightings(std::span<const ObservationType> observations,
+                                                  const UpdateResult& result) const
+    -> std::vector<typename Reacquisition::Sighting> {
+  std::vector<const ObservationType*> rejected;
+  std::vector<Eigen::Index> offsets;
+  for (const auto& observation : observations)
+    if (std::find(result.rejected.begin(), result.rejected.end(), observation.landmark_id) != result.rejected.end()) {
+      rejected.push_back(&observation);
+      offsets.push_back(offset_of(landmarks_.slot(observation.landmark_id)));
+    }
+  const Eigen::MatrixXd joint = joint_covariance(offsets);
+  std::vector<typename Reacquisition::Sighting> out;
+  for (std::size_t i = 0; i < rejected.size(); ++i) {
+    const Landmark m = landmark_mean(landmarks_.slot(rejected[i]->landmark_id));
+    try {
+      const auto p = with_noise_scale(sensor_.predict(x_, m), rejected[i]->noise_scale);
+      const Eigen::Index at = X + M * static_cast<Eigen::Index>(i);
+      const Eigen::Matrix<double, M, M> P_mm = symmetrized(Eigen::Matrix<double, M, M>(joint.template block<M, M>(at, at)));
+      out.push_back({rejected[i]->landmark_id, x_, m, rejected[i]->z, symmetrized(p.J_z_m * P_mm * p.J_z_m.transpose() + p.Q)});
+    } catch (const error&) {
+    }
+  }
   return out;
 }
 
