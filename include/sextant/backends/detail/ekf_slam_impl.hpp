@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "sextant/core/iterate_settled.hpp"
 #include "sextant/core/landmark_init.hpp"
 #include "sextant/core/validation.hpp"
 
@@ -116,7 +117,7 @@ void EkfSlam<Motion, Sensor>::relinearize_at_iterates(std::span<const Observatio
     const double moved = (next.delta - correction.delta).template lpNorm<Eigen::Infinity>();
     observations = std::move(*relinearized);
     correction = std::move(next);
-    if (moved <= 1e-9 * (1.0 + correction.delta.template lpNorm<Eigen::Infinity>())) return;
+    if (iterate_settled(moved, correction.delta.template lpNorm<Eigen::Infinity>())) return;
   }
 }
 

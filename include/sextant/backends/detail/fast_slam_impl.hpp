@@ -9,6 +9,7 @@
 #include <string>
 
 #include "sextant/core/gaussian_mixture.hpp"
+#include "sextant/core/iterate_settled.hpp"
 #include "sextant/core/landmark_init.hpp"
 #include "sextant/core/validation.hpp"
 
@@ -257,7 +258,7 @@ auto FastSlam<Motion, Sensor, Map>::iterated_proposal(double log_weight, const P
     const double moved = Space::minus(next->mean, proposal.mean).template lpNorm<Eigen::Infinity>();
     const double step = Space::minus(next->mean, prior.mean).template lpNorm<Eigen::Infinity>();
     proposal = std::move(*next);
-    if (moved <= 1e-9 * (1.0 + step)) break;
+    if (iterate_settled(moved, step)) break;
   }
   return proposal;
 }

@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "sextant/core/factor_information.hpp"
+#include "sextant/core/iterate_settled.hpp"
 #include "sextant/core/landmark_init.hpp"
 #include "sextant/core/seif_sparsification.hpp"
 #include "sextant/core/validation.hpp"
@@ -319,7 +320,7 @@ void SeifSlam<Motion, Sensor>::relinearize_at_iterates(std::span<const Observati
     for (const auto& info : step)
       moved = std::max({moved, Space::minus(x_, info.at_x).template lpNorm<Eigen::Infinity>(),
                         (landmark_mean(info.slot) - info.at_m).template lpNorm<Eigen::Infinity>()});
-    if (moved <= 1e-9 * (1.0 + Space::minus(x_, prior).template lpNorm<Eigen::Infinity>())) break;
+    if (iterate_settled(moved, Space::minus(x_, prior).template lpNorm<Eigen::Infinity>())) break;
   }
 }
 
