@@ -158,8 +158,9 @@ class SeifSlam {
   /// when the motion Jacobian is singular; the state is then unchanged.
   void predict(const Control& u, double dt);
 
-  /// Measurement update, new landmarks, mean recovery and sparsification. Bad input (NaN/Inf,
-  /// repeated ids, non-PD noise) throws before anything changes.
+  /// Measurement update, new landmarks, mean recovery and sparsification, then re-acquisition's
+  /// bookkeeping (options().reacquisition; never throws). Bad input (NaN/Inf, repeated ids, non-PD
+  /// noise) throws before anything changes.
   UpdateResult update(std::span<const ObservationType> observations);
   UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }
 

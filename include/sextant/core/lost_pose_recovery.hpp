@@ -8,8 +8,8 @@
 ///   a member `recovery_` of this type (the copy's is switched off);
 /// and takes a winning candidate's estimate itself (follow_up returns it).
 
+#include <exception>
 #include <memory>
-#include <new>
 #include <span>
 #include <vector>
 
@@ -52,8 +52,8 @@ class LostPoseRecovery {
   /// both hypotheses and, once over, returns the candidate if it explained them better (the filter
   /// then takes its estimate; result.pose_reacquired is set); otherwise an update that accepted
   /// nothing adds its rejections to the record and may start a probation. Never throws: a candidate
-  /// that cannot take an update is dropped, an attempt memory runs out for is skipped, so the
-  /// filter's update keeps its strong guarantee.
+  /// that cannot take an update is dropped, an attempt that fails (memory, the rejected sightings'
+  /// marginals) is skipped with its record, so the filter's update keeps its strong guarantee.
   template <class Observation>
   std::unique_ptr<Filter> follow_up(const Filter& filter, std::span<const Observation> observations,
                                     UpdateResult& result) noexcept {
@@ -78,7 +78,7 @@ class LostPoseRecovery {
       if (result.rejected.empty()) return nullptr;
       if (const auto d = record_.add_rejected(filter.rejected_sightings(observations, result), filter.sensor_))
         start_probation(filter, *d);
-    } catch (const std::bad_alloc&) {
+    } catch (const std::exception&) {  // memory for a candidate, a marginal the filter cannot give
       probation_.drop();
       record_.forget_record();
     }
