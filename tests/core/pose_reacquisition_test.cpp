@@ -1,10 +1,12 @@
 // PoseReacquisition (core/pose_reacquisition.hpp): the offset that the rejected sightings of a lost
-// pose agree on, the drift test, the rules of the record, and the probation's copy of its candidate.
+// pose agree on, the drift test, the rules of the record, and the probation's copy of its candidate;
+// LostPoseRecovery (core/lost_pose_recovery.hpp) around a filter reduced to what it asks of one.
 #include <gtest/gtest.h>
 
 #include <numbers>
 #include <random>
 
+#include "sextant/core/lost_pose_recovery.hpp"
 #include "sextant/core/pose_reacquisition.hpp"
 #include "sextant/models/range_bearing_2d.hpp"
 #include "sextant/models/se2_world_frame.hpp"
@@ -113,6 +115,49 @@ TEST(PoseProbation, CopiesItsCandidateAndKeepsTheHypothesisThatExplainsTheSighti
   EXPECT_FALSE(copy.count(5, -7.0, -7.0, 5) && copy.candidate_won()) << "a tie keeps the filter";
   EXPECT_EQ(probation.release()->size(), 3u);
   EXPECT_FALSE(probation.active());
+}
+
+/// What LostPoseRecovery asks of a back-end, and no more: its rejections are six sightings of a pose
+/// lost by (0.4, -0.3, 0.2) (or reading them fails, as SEIF's marginals can), its update reports a
+/// fixed likelihood, which the moved copy betters.
+struct FilterReducedToItsHooks {
+  using Recovery = LostPoseRecovery<FilterReducedToItsHooks, Reacquisition>;
+  using Observations = std::span<const Observation<Eigen::Vector2d>>;
+  Sensor sensor_ = range_bearing();
+  Recovery recovery_;
+  bool marginals_fail = false;
+  Eigen::Vector3d moved_by = Eigen::Vector3d::Zero();
+  double log_likelihood = -10.0;
+
+  std::vector<Sighting> rejected_sightings(Observations, const UpdateResult&) const {
+    if (marginals_fail) throw numerical_error("the rejected sightings' marginals cannot be read");
+    return sightings_of_a_pose_lost_by(Eigen::Vector3d(0.4, -0.3, 0.2));
+  }
+  void reacquire_pose(const Eigen::Vector3d& d) {
+    moved_by = d;
+    log_likelihood = -1.0;
+  }
+  UpdateResult update(Observations) const { return {.corrected = 20, .log_likelihood = log_likelihood}; }
+};
+
+/// An update that rejected everything starts the probation of a copy moved by the offset the
+/// rejections agree on; the copy explains the next 20 sightings better and follow_up hands it over,
+/// with result.pose_reacquired. Where the rejections cannot be read, the attempt is skipped: no
+/// throw out of follow_up (it is noexcept, so a throw would end the program), no probation.
+TEST(LostPoseRecovery, HandsOverTheMovedCopyThatExplainsTheSightingsBetterAndSkipsAnAttemptItCannotMake) {
+  const std::vector<Observation<Eigen::Vector2d>> none;
+  for (const bool fail : {false, true}) {
+    FilterReducedToItsHooks filter{.recovery_ = {{.min_landmarks = 3}, 0.9999}, .marginals_fail = fail};
+    filter.recovery_.set_drift(Eigen::Vector3d(1.0, 1.0, 0.5).asDiagonal());
+    UpdateResult all_rejected{.rejected = {0, 1, 2}, .log_likelihood = -30.0};
+    EXPECT_EQ(filter.recovery_.follow_up(filter, std::span(none), all_rejected), nullptr);
+    UpdateResult next = filter.update(none);
+    const auto winner = filter.recovery_.follow_up(filter, std::span(none), next);
+    EXPECT_EQ(winner != nullptr, !fail);
+    EXPECT_EQ(next.pose_reacquired, !fail);
+    if (winner) EXPECT_LT((winner->moved_by - Eigen::Vector3d(0.4, -0.3, 0.2)).norm(), 1e-6);
+    EXPECT_EQ(filter.moved_by, Eigen::Vector3d::Zero()) << "the filter itself is never moved by follow_up";
+  }
 }
 
 }  // namespace
