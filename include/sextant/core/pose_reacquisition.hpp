@@ -45,6 +45,7 @@
 #include "sextant/core/chi_square.hpp"
 #include "sextant/core/concepts.hpp"
 #include "sextant/core/error.hpp"
+#include "sextant/core/gaussian.hpp"
 #include "sextant/core/observation.hpp"
 
 namespace sextant {
@@ -82,6 +83,18 @@ class PoseReacquisition {
     Measurement z;
     Eigen::Matrix<double, Z, Z> S;  ///< J_m P_m J_m^T + Q: its covariance with the robot known
   };
+  /// The sighting `observation` made from the robot at x of a landmark with mean m and covariance
+  /// P_mm; nothing where the model cannot predict it (it then tells nothing about an offset).
+  template <class Observation, class LandmarkCovariance>
+  static std::optional<Sighting> sighting(const Sensor& sensor, const State& x, const Landmark& m,
+                                          const Observation& observation, const LandmarkCovariance& P_mm) {
+    try {
+      const auto p = with_noise_scale(sensor.predict(x, m), observation.noise_scale);
+      return Sighting{observation.landmark_id, x, m, observation.z, symmetrized(p.J_z_m * P_mm * p.J_z_m.transpose() + p.Q)};
+    } catch (const error&) {
+      return std::nullopt;
+    }
+  }
 
   /// The most recent rejections the test reads: the older ones were made further back along the
   /// dead-reckoned path, and the record stays bounded through a long spell of outliers.

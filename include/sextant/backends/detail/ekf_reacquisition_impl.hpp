@@ -35,14 +35,9 @@ auto EkfSlam<Motion, Sensor>::rejected_sightings(std::span<const ObservationType
   for (const auto& observation : observations) {
     if (std::find(result.rejected.begin(), result.rejected.end(), observation.landmark_id) == result.rejected.end()) continue;
     const std::size_t slot = landmarks_.slot(observation.landmark_id);
-    const Landmark m = landmark_mean(slot);
-    try {
-      const auto p = with_noise_scale(sensor_.predict(x_, m), observation.noise_scale);
-      const Eigen::Matrix<double, M, M> P_mm = symmetric_diagonal_block<M>(cov_.view(), offset_of(slot));
-      out.push_back({observation.landmark_id, x_, m, observation.z,
-                     symmetrized(p.J_z_m * P_mm * p.J_z_m.transpose() + p.Q)});
-    } catch (const error&) {
-    }
+    const Eigen::Matrix<double, M, M> P_mm = symmetric_diagonal_block<M>(cov_.view(), offset_of(slot));
+    if (auto sighting = Reacquisition::sighting(sensor_, x_, landmark_mean(slot), observation, P_mm))
+      out.push_back(std::move(*sighting));
   }
   return out;
 }

@@ -1060,14 +1060,11 @@ auto SeifSlam<Motion, Sensor>::rejected_sightings(std::span<const ObservationTyp
   const Eigen::MatrixXd joint = joint_covariance(offsets);
   std::vector<typename Reacquisition::Sighting> out;
   for (std::size_t i = 0; i < rejected.size(); ++i) {
-    const Landmark m = landmark_mean(landmarks_.slot(rejected[i]->landmark_id));
-    try {
-      const auto p = with_noise_scale(sensor_.predict(x_, m), rejected[i]->noise_scale);
-      const Eigen::Index at = X + M * static_cast<Eigen::Index>(i);
-      const Eigen::Matrix<double, M, M> P_mm = symmetrized(Eigen::Matrix<double, M, M>(joint.template block<M, M>(at, at)));
-      out.push_back({rejected[i]->landmark_id, x_, m, rejected[i]->z, symmetrized(p.J_z_m * P_mm * p.J_z_m.transpose() + p.Q)});
-    } catch (const error&) {
-    }
+    const Eigen::Index at = X + M * static_cast<Eigen::Index>(i);
+    const Eigen::Matrix<double, M, M> P_mm = symmetrized(Eigen::Matrix<double, M, M>(joint.template block<M, M>(at, at)));
+    if (auto sighting = Reacquisition::sighting(sensor_, x_, landmark_mean(landmarks_.slot(rejected[i]->landmark_id)),
+                                                *rejected[i], P_mm))
+      out.push_back(std::move(*sighting));
   }
   return out;
 }
