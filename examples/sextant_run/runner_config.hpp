@@ -781,6 +781,10 @@ inline std::vector<ConfigKey> fastslam_keys() {
      "linearizations of FastSLAM 2.0's proposal per update, each at the previous one's pose and landmarks (as "
      "[ekf] iterations; 1 = the textbook proposal): docs/results/iterated_ekf.md",
      [](RunnerConfig& c, const std::string& v) { c.fastslam.iterations = parse_integer<int>(v, 1, 100); }},
+    {"fastslam", "student_t_dof", "0",
+     "the measurement noise as a Student-t of this many degrees of freedom (gross outliers): each update's noise "
+     "scaled by (dof + NIS) / (dof + d), each weight the t density (0: Gaussian)",
+     [](RunnerConfig& c, const std::string& v) { c.fastslam.student_t_dof = non_negative(parse_number(v), v); }},
   };
 }
 

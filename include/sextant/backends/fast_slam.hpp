@@ -19,6 +19,7 @@
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/innovation_gate.hpp"
 #include "sextant/core/persistent_array.hpp"
+#include "sextant/core/student_t.hpp"
 #include "sextant/core/update_result.hpp"
 
 namespace sextant {
@@ -71,6 +72,13 @@ struct FastSlamOptions {
   /// update_unassociated associates in the first pass and iterates what it paired. It matters where
   /// a landmark is close to the sensor compared with the pose's spread (docs/results/iterated_ekf.md).
   int iterations = 1;
+  /// Degrees of freedom nu of the measurement noise as a Student-t (core/student_t.hpp: heavy tails,
+  /// gross outliers): each observation of a known or associated landmark updates with its noise Q
+  /// scaled by (nu + NIS) / (nu + d), NIS against the innovation covariance S of that update, and
+  /// weighs on its particle by the t density with scale S instead of the Gaussian's, so that one
+  /// sighting far off its landmark neither drags the pose and landmark nor kills the particle that has
+  /// them right. The new-landmark weight takes the same density. 0 (the default) = Gaussian.
+  double student_t_dof = 0.0;
 };
 
 /// One landmark of one particle: an EKF over its position (eqs. 75-78).
@@ -221,21 +229,32 @@ class FastSlam {
   using PoseMatrix = Eigen::Matrix<double, X, X>;
   static constexpr std::size_t kNewLandmark = ~std::size_t{0};  ///< association: no landmark, start one
   using Prediction = decltype(std::declval<const Sensor&>().predict(std::declval<const State&>(), std::declval<const Landmark&>()));
-  /// A measurement of a landmark against the Gaussian proposal of the pose (FastSLAM 2.0).
+  /// What an update makes of an innovation nu with covariance S whose noise part is Q: its NIS
+  /// against S, the factor c on Q (1 for Gaussian noise; FastSlamOptions::student_t_dof), the
+  /// Cholesky factor of the covariance the update uses, S + (c - 1) Q, and the observation's log
+  /// likelihood against S (its factor of the particle's weight).
+  struct WeighedInnovation {
+    double nis;
+    double noise_factor;
+    Eigen::LLT<Eigen::Matrix<double, Z, Z>> llt;
+    double log_likelihood;
+  };
+  WeighedInnovation weigh_innovation(const Eigen::Matrix<double, Z, Z>& S, const Eigen::Matrix<double, Z, 1>& nu,
+                                     const Eigen::Matrix<double, Z, Z>& Q, const char* what) const;
+  /// A measurement of a landmark against the Gaussian proposal of the pose (FastSLAM 2.0), weighed
+  /// with S = H_x Sigma H_x^T + H_m Sigma_m H_m^T + Q.
   struct ProposalInnovation {
     Prediction prediction;
     Eigen::Matrix<double, Z, 1> nu;
-    Eigen::LLT<Eigen::Matrix<double, Z, Z>> llt;  ///< of S = H_x Sigma H_x^T + H_m Sigma_m H_m^T + Q
+    WeighedInnovation weighed;
   };
   auto predict_if_observable(const State& x, const Landmark& m, double noise_scale) const -> std::optional<Prediction>;
   std::vector<ObservationType> add_new_landmarks(std::vector<Particle>& particles, std::span<const ObservationType> fresh,
                                                  std::vector<LandmarkId>& unusable) const;
   LandmarkUpdate update_landmark(Particle& particle, std::size_t index, const Measurement& z, double noise_scale,
                                  bool unassociated) const;
-  template <class Llt>
-  double log_likelihood_at_gate_edge(const Llt& llt) const;
   ProposalInnovation proposal_innovation(Prediction prediction, const PoseMatrix& cov, const LandmarkGaussian<M>& landmark,
-                                         const Measurement& z) const;
+                                         const Measurement& z, const Eigen::Matrix<double, Z, 1>& offset) const;
   static double fold_into_proposal(State& mean, PoseMatrix& cov, const ProposalInnovation& innovation);
   std::vector<Outcome> propose_v2(Particle& particle, const PoseEstimate& prior, std::span<const ObservationType> known,
                                   const std::vector<bool>& accepted) const;
@@ -315,6 +334,7 @@ class FastSlam {
   Sensor sensor_;
   FastSlamOptions options_;
   InnovationGate gate_;
+  StudentTNoise noise_tails_;  ///< options_.student_t_dof
   std::vector<Particle> particles_;
   std::unordered_map<LandmarkId, std::size_t> index_;  ///< id -> index in every particle's map
   std::vector<LandmarkId> id_of_index_;  ///< index -> id; an index whose id was removed is stale

@@ -24,6 +24,7 @@
 #include "sextant/core/joint_marginal.hpp"
 #include "sextant/core/observation.hpp"
 #include "sextant/core/pose_mean.hpp"
+#include "sextant/core/student_t.hpp"
 #include "sextant/vision/stereo_front_end.hpp"
 #include "sextant/vision/stereo_matching.hpp"
 
@@ -38,7 +39,7 @@ struct MapAssociationOptions {
   /// new one in view. 0: every gate blocks.
   double new_landmark_density = 0.0;
   /// Degrees of freedom nu of a re-observation's error as a Student-t (a Gaussian N(0, Q / lambda)
-  /// with lambda ~ Gamma(nu/2, nu/2): heavy tails). Its noise is scaled by sqrt((nu + NIS) / (nu + 3)),
+  /// with lambda ~ Gamma(nu/2, nu/2): heavy tails, core/student_t.hpp). Its noise is scaled by sqrt((nu + NIS) / (nu + 3)),
   /// 1 / sqrt(E[lambda | innovation]) with the innovation taken as t-distributed with scale S (as in
   /// Roth, Özkan and Gustafsson's t filter, 2013), applied to Q alone. A far re-observation weighs
   /// less, a near one more. Nu = 4: Lange, Little and Taylor (JASA 1989). 0: Gaussian.
@@ -79,9 +80,7 @@ inline void require_valid(const MapAssociationOptions& o) {
   if (!(o.new_landmark_density >= 0.0))
     throw invalid_input_error("map association: new_landmark_density " + std::to_string(o.new_landmark_density) +
                               " per m^3 must be >= 0");
-  if (!(o.student_t_dof >= 0.0) || !std::isfinite(o.student_t_dof))
-    throw invalid_input_error("map association: student_t_dof " + std::to_string(o.student_t_dof) +
-                              " must be >= 0 and finite (0: Gaussian re-observations)");
+  StudentTNoise{o.student_t_dof}.validate("map association: student_t_dof");
   if (!(o.ratio > 0.0))
     throw invalid_input_error("map association: ratio " + std::to_string(o.ratio) + " must be > 0 (1 or more: no ratio test)");
   (void)descriptor_distance_bound(o);
@@ -323,8 +322,7 @@ inline std::vector<std::optional<FeaturePair>> one_to_one(std::vector<FeaturePai
 /// A re-observation's noise scale: the feature's, times the Student-t's where student_t_dof > 0
 /// (`nis`: the pair's, under the feature's own gate).
 inline double reobservation_noise_scale(double feature_scale, double nis, const MapAssociationOptions& o) {
-  if (!(o.student_t_dof > 0.0)) return feature_scale;
-  return feature_scale * std::sqrt((o.student_t_dof + nis) / (o.student_t_dof + 3.0));
+  return feature_scale * std::sqrt(StudentTNoise{o.student_t_dof}.noise_factor(nis, 3));
 }
 
 }  // namespace detail

@@ -33,6 +33,8 @@ FastSlam<Motion, Sensor, Map>::FastSlam(Motion motion, Sensor sensor, const Pose
   if (!(options_.new_landmark_nis > 0.0) || !std::isfinite(options_.new_landmark_nis))
     throw invalid_input_error("FastSlamOptions: new_landmark_nis must be positive and finite (0: the default)");
   gate_ = InnovationGate(Z, options_.gate_probability);
+  noise_tails_ = StudentTNoise{options_.student_t_dof};
+  noise_tails_.validate("FastSlamOptions: student_t_dof");
   particles_.resize(options_.particles);
   const PoseMatrix tail = kept_tail(prior.cov);
   for (std::size_t n = 0; n < particles_.size(); ++n) {
@@ -147,16 +149,24 @@ void FastSlam<Motion, Sensor, Map>::apply_pending_motion_v1(Transaction& t) cons
   t.pending.clear();
 }
 
-/// The weight of a measurement on the gate's edge, log N at NIS = threshold: what a rejected
-/// observation (or a new landmark) contributes, so that an outlier neither ruins nor favours a particle.
+/// The innovation's NIS against S, and with heavy-tailed noise (core/student_t.hpp) the factor c on
+/// Q and the factor of S + (c - 1) Q; the log likelihood log t_nu(nu; 0, S), or log N(nu; 0, S)
+/// (eqs. 79-81, 93) with S itself for Gaussian noise.
 template <class Motion, class Sensor, template <class> class Map>
-template <class Llt>
-double FastSlam<Motion, Sensor, Map>::log_likelihood_at_gate_edge(const Llt& llt) const {
-  return log_gaussian(llt, Eigen::Matrix<double, Z, 1>::Zero().eval()) - 0.5 * gate_.threshold();
+auto FastSlam<Motion, Sensor, Map>::weigh_innovation(const Eigen::Matrix<double, Z, Z>& S,
+                                                     const Eigen::Matrix<double, Z, 1>& nu,
+                                                     const Eigen::Matrix<double, Z, Z>& Q, const char* what) const
+    -> WeighedInnovation {
+  auto llt = cholesky_or_throw(S, what);
+  const double nis = mahalanobis_squared(llt, nu);
+  const double log_likelihood = noise_tails_.log_density_at_nis(llt, nis);
+  const double c = noise_tails_.noise_factor(nis, Z);
+  if (c != 1.0) llt = cholesky_or_throw(symmetrized((S + (c - 1.0) * Q).eval()), what);
+  return {nis, c, std::move(llt), log_likelihood};
 }
 
-/// One landmark EKF update with the particle's pose (eqs. 75-78, Joseph form); returns the log
-/// likelihood log N(nu; 0, S), S = H_m Sigma_m H_m^T + Q (eqs. 79-81).
+/// One landmark EKF update with the particle's pose (eqs. 75-78, Joseph form, the noise c Q of
+/// weigh_innovation); returns the log likelihood, S = H_m Sigma_m H_m^T + Q (eqs. 79-81).
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::size_t index, const Measurement& z,
                                                     double noise_scale, bool unassociated) const -> LandmarkUpdate {
@@ -167,12 +177,13 @@ auto FastSlam<Motion, Sensor, Map>::update_landmark(Particle& particle, std::siz
   const auto& pred = *prediction;
   const Eigen::Matrix<double, Z, 1> nu = sensor_.residual(z, pred.z);
   const Eigen::Matrix<double, Z, Z> S = symmetrized(pred.J_z_m * L.cov * pred.J_z_m.transpose() + pred.Q);
-  const auto llt = cholesky_or_throw(S, "landmark innovation covariance");
-  const Eigen::Matrix<double, M, Z> K = llt.solve(pred.J_z_m * L.cov).transpose();
+  const auto w = weigh_innovation(S, nu, pred.Q, "landmark innovation covariance");
+  const Eigen::Matrix<double, M, Z> K = w.llt.solve(pred.J_z_m * L.cov).transpose();
   const Eigen::Matrix<double, M, M> I_KH = Eigen::Matrix<double, M, M>::Identity() - K * pred.J_z_m;
-  LandmarkGaussian<M> updated{L.mean + K * nu, symmetrized(I_KH * L.cov * I_KH.transpose() + K * pred.Q * K.transpose()),
-                              true, L.id};
-  const double log_likelihood = log_gaussian(llt, nu);
+  LandmarkGaussian<M> updated{
+      L.mean + K * nu,
+      symmetrized(I_KH * L.cov * I_KH.transpose() + w.noise_factor * (K * pred.Q * K.transpose())), true, L.id};
+  const double log_likelihood = w.log_likelihood;
   if (!updated.mean.allFinite() || !updated.cov.allFinite() || !std::isfinite(log_likelihood))
     throw numerical_error("landmark update is not finite");
   map.set(index, std::move(updated));
@@ -196,26 +207,30 @@ auto FastSlam<Motion, Sensor, Map>::predict_if_observable(const State& x, const 
 /// N(g(x, u), R), each observation of a known landmark corrects the pose Gaussian with
 /// S = H_x Sigma H_x^T + H_m Sigma_m H_m^T + Q; the weight gains log N(nu; 0, S) (eq. 93, chained
 /// over the observations); the pose is then sampled from the result. An observation that fails the
-/// gate does not shape the proposal and weighs as on the gate's edge; the result flags it.
+/// gate does not shape the proposal and weighs as on the gate's edge; the result flags it. The
+/// innovation is residual(z, h) - offset (offset: an iterated pass's relinearization, fold_proposal).
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::proposal_innovation(Prediction prediction, const PoseMatrix& cov,
-                                                        const LandmarkGaussian<M>& landmark, const Measurement& z) const
+                                                        const LandmarkGaussian<M>& landmark, const Measurement& z,
+                                                        const Eigen::Matrix<double, Z, 1>& offset) const
     -> ProposalInnovation {
   const Eigen::Matrix<double, Z, Z> S = symmetrized(prediction.J_z_x * cov * prediction.J_z_x.transpose() +
                                                     prediction.J_z_m * landmark.cov * prediction.J_z_m.transpose() +
                                                     prediction.Q);
-  Eigen::Matrix<double, Z, 1> nu = sensor_.residual(z, prediction.z);
-  return {std::move(prediction), std::move(nu), cholesky_or_throw(S, "proposal innovation covariance")};
+  Eigen::Matrix<double, Z, 1> nu = sensor_.residual(z, prediction.z) - offset;
+  auto weighed = weigh_innovation(S, nu, prediction.Q, "proposal innovation covariance");
+  return {std::move(prediction), std::move(nu), std::move(weighed)};
 }
 
 /// One measurement folded into the Gaussian proposal of the pose (thesis eqs. 91-92): K = Sigma H_x^T S^-1,
-/// mu = mu (+) K nu, Sigma = (I - K H_x) Sigma. Returns log N(nu; 0, S), its factor of the weight (eq. 93).
+/// mu = mu (+) K nu, Sigma = (I - K H_x) Sigma (S with the noise c Q, weigh_innovation). Returns its
+/// factor of the weight (eq. 93).
 template <class Motion, class Sensor, template <class> class Map>
 double FastSlam<Motion, Sensor, Map>::fold_into_proposal(State& mean, PoseMatrix& cov, const ProposalInnovation& in) {
-  const Eigen::Matrix<double, X, Z> K = in.llt.solve(in.prediction.J_z_x * cov).transpose();
+  const Eigen::Matrix<double, X, Z> K = in.weighed.llt.solve(in.prediction.J_z_x * cov).transpose();
   mean = Space::plus(mean, K * in.nu);
   cov = symmetrized((PoseMatrix::Identity() - K * in.prediction.J_z_x) * cov);
-  return log_gaussian(in.llt, in.nu);
+  return in.weighed.log_likelihood;
 }
 
 /// FastSLAM 2.0's Gaussian proposal of one particle's pose, folded from its motion prior and the
@@ -269,7 +284,8 @@ auto FastSlam<Motion, Sensor, Map>::iterated_proposal(double log_weight, const P
 /// A further pass linearizes measurement i at (at->x, at->m[i]) and refers its residual back to the
 /// running mean mu and the landmark's mean m: nu = z - h(x_i, m_i) - H_x (mu - x_i) - H_m (m - m_i)
 /// (nothing where the model cannot predict one). The weight starts from the particle's and gains each
-/// log N(nu; 0, S). With iterations asked for, the pass also gives the next one's linearization.
+/// one's log likelihood (weigh_innovation). With iterations asked for, the pass also gives the next
+/// one's linearization.
 /// Measurement i is known[i] of the landmark landmarks[i].
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::fold_proposal(double log_weight, const PoseEstimate& prior,
@@ -289,10 +305,10 @@ auto FastSlam<Motion, Sensor, Map>::fold_proposal(double log_weight, const PoseE
       outcomes[i] = Outcome::unusable;
       continue;
     }
-    auto innovation = proposal_innovation(std::move(*prediction), out.cov, L, known[i].z);
-    if (at)
-      innovation.nu -= innovation.prediction.J_z_x * Space::minus(out.mean, x_i) +
-                       innovation.prediction.J_z_m * (L.mean - at->m[i]);
+    const Eigen::Matrix<double, Z, 1> offset =
+        at ? (prediction->J_z_x * Space::minus(out.mean, x_i) + prediction->J_z_m * (L.mean - at->m[i])).eval()
+           : Eigen::Matrix<double, Z, 1>::Zero().eval();
+    auto innovation = proposal_innovation(std::move(*prediction), out.cov, L, known[i].z, offset);
     out.log_weight += fold_into_proposal(out.mean, out.cov, innovation);
     if (options_.iterations > 1) folded.push_back({i, x_i, std::move(innovation)});
   }
@@ -315,8 +331,9 @@ auto FastSlam<Motion, Sensor, Map>::next_linearization(std::span<const Observati
     const auto& p = innovation.prediction;
     Eigen::Matrix<double, Z, 1> nu = sensor_.residual(known[i].z, p.z) - p.J_z_x * Space::minus(x, x_i);
     if (at) nu -= p.J_z_m * (L.mean - at->m[i]);
-    const auto R = cholesky_or_throw(symmetrized(p.J_z_m * L.cov * p.J_z_m.transpose() + p.Q),
-                                     "landmark innovation covariance");
+    const auto R = cholesky_or_throw(
+        symmetrized(p.J_z_m * L.cov * p.J_z_m.transpose() + innovation.weighed.noise_factor * p.Q),
+        "landmark innovation covariance");
     next.m[i] = Landmark(L.mean + L.cov * p.J_z_m.transpose() * R.solve(nu));
   }
   return next;
@@ -783,8 +800,9 @@ std::vector<std::size_t> FastSlam<Motion, Sensor, Map>::associate_in_particle(Pa
     for (std::size_t j = 0; j < particle.unassociated.size(); ++j) {
       const auto& L = particle.unassociated[j];
       if (!L.alive) continue;
-      auto innovation = proposal_innovation(sensor_.predict(mean, L.mean), cov, L, measurements[i]);
-      const double nis = mahalanobis_squared(innovation.llt, innovation.nu);
+      auto innovation =
+          proposal_innovation(sensor_.predict(mean, L.mean), cov, L, measurements[i], Eigen::Matrix<double, Z, 1>::Zero());
+      const double nis = innovation.weighed.nis;
       if (nis < best_nis) best_nis = nis, match[i] = j, best = std::move(innovation);
     }
     if (proposal && best) particle.log_weight += fold_into_proposal(mean, cov, *best);
@@ -843,13 +861,13 @@ auto FastSlam<Motion, Sensor, Map>::iterated_proposal_of_matches(const Particle&
   return iterated_proposal(log_weight, prior, paired, landmarks, outcomes);
 }
 
-/// log N(0; 0, Q) - new_landmark_nis / 2: what a new landmark weighs, as a measurement on the
-/// new-landmark gate's edge, with the measurement noise at pose x.
+/// What a new landmark weighs: a measurement on the new-landmark gate's edge (NIS = new_landmark_nis)
+/// against the measurement noise Q at pose x, log N (the Gaussian's log N(0; 0, Q) - new_landmark_nis
+/// / 2) or log t with heavy-tailed noise.
 template <class Motion, class Sensor, template <class> class Map>
 double FastSlam<Motion, Sensor, Map>::new_landmark_log_weight(const State& x, const Measurement& z) const {
   const auto init = initialize_landmark(sensor_, x, z, LandmarkId{0}, 1.0);
-  return log_gaussian(cholesky_or_throw(init.Q, "measurement noise"), Eigen::Matrix<double, Z, 1>::Zero().eval()) -
-         0.5 * options_.new_landmark_nis;
+  return noise_tails_.log_density_at_nis(cholesky_or_throw(init.Q, "measurement noise"), options_.new_landmark_nis);
 }
 
 /// One particle's landmarks in update_unassociated: with FastSLAM 2.0 its pose drawn from the
