@@ -255,6 +255,9 @@ class FastSlam {
                                  bool unassociated) const;
   ProposalInnovation proposal_innovation(Prediction prediction, const PoseMatrix& cov, const LandmarkGaussian<M>& landmark,
                                          const Measurement& z, const Eigen::Matrix<double, Z, 1>& offset) const;
+  static Eigen::Matrix<double, Z, Z> proposal_covariance(const Prediction& prediction, const PoseMatrix& cov,
+                                                         const LandmarkGaussian<M>& landmark);
+  static constexpr const char* kProposalS = "proposal innovation covariance";
   static double fold_into_proposal(State& mean, PoseMatrix& cov, const ProposalInnovation& innovation);
   std::vector<Outcome> propose_v2(Particle& particle, const PoseEstimate& prior, std::span<const ObservationType> known,
                                   const std::vector<bool>& accepted) const;

@@ -214,12 +214,17 @@ auto FastSlam<Motion, Sensor, Map>::proposal_innovation(Prediction prediction, c
                                                         const LandmarkGaussian<M>& landmark, const Measurement& z,
                                                         const Eigen::Matrix<double, Z, 1>& offset) const
     -> ProposalInnovation {
-  const Eigen::Matrix<double, Z, Z> S = symmetrized(prediction.J_z_x * cov * prediction.J_z_x.transpose() +
-                                                    prediction.J_z_m * landmark.cov * prediction.J_z_m.transpose() +
-                                                    prediction.Q);
   Eigen::Matrix<double, Z, 1> nu = sensor_.residual(z, prediction.z) - offset;
-  auto weighed = weigh_innovation(S, nu, prediction.Q, "proposal innovation covariance");
+  auto weighed = weigh_innovation(proposal_covariance(prediction, cov, landmark), nu, prediction.Q, kProposalS);
   return {std::move(prediction), std::move(nu), std::move(weighed)};
+}
+
+/// S = H_x Sigma H_x^T + H_m Sigma_m H_m^T + Q of a measurement against the pose Gaussian (Sigma).
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::proposal_covariance(const Prediction& prediction, const PoseMatrix& cov,
+                                                        const LandmarkGaussian<M>& landmark) -> Eigen::Matrix<double, Z, Z> {
+  return symmetrized(prediction.J_z_x * cov * prediction.J_z_x.transpose() +
+                     prediction.J_z_m * landmark.cov * prediction.J_z_m.transpose() + prediction.Q);
 }
 
 /// One measurement folded into the Gaussian proposal of the pose (thesis eqs. 91-92): K = Sigma H_x^T S^-1,
@@ -796,16 +801,20 @@ std::vector<std::size_t> FastSlam<Motion, Sensor, Map>::associate_in_particle(Pa
   std::vector<std::size_t> match(measurements.size(), kNewLandmark);
   for (std::size_t i = 0; i < measurements.size(); ++i) {
     double best_nis = options_.new_landmark_nis;
-    std::optional<ProposalInnovation> best;
+    std::optional<Prediction> best;
     for (std::size_t j = 0; j < particle.unassociated.size(); ++j) {
       const auto& L = particle.unassociated[j];
       if (!L.alive) continue;
-      auto innovation =
-          proposal_innovation(sensor_.predict(mean, L.mean), cov, L, measurements[i], Eigen::Matrix<double, Z, 1>::Zero());
-      const double nis = innovation.weighed.nis;
-      if (nis < best_nis) best_nis = nis, match[i] = j, best = std::move(innovation);
+      auto prediction = sensor_.predict(mean, L.mean);
+      const auto llt = cholesky_or_throw(proposal_covariance(prediction, cov, L), kProposalS);
+      const double nis = mahalanobis_squared(llt, sensor_.residual(measurements[i], prediction.z));
+      if (nis < best_nis) best_nis = nis, match[i] = j, best = std::move(prediction);
     }
-    if (proposal && best) particle.log_weight += fold_into_proposal(mean, cov, *best);
+    if (!proposal || !best) continue;
+    // Only the chosen landmark is weighed (its likelihood, with heavy tails its noise factor).
+    const auto chosen = proposal_innovation(std::move(*best), cov, particle.unassociated[match[i]], measurements[i],
+                                            Eigen::Matrix<double, Z, 1>::Zero());
+    particle.log_weight += fold_into_proposal(mean, cov, chosen);
   }
   return match;
 }
