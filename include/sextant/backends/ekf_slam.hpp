@@ -197,8 +197,6 @@ class EkfSlam {
   using Reacquisition = PoseReacquisition<Space, Sensor, State, X>;
   using Recovery = LostPoseRecovery<EkfSlam, Reacquisition>;
   friend Recovery;
-  /// A candidate that won its probation: its estimate replaces this one's.
-  void adopt_estimate(EkfSlam&& candidate);
   std::vector<typename Reacquisition::Sighting> rejected_sightings(std::span<const ObservationType> observations,
                                                                    const UpdateResult& result) const;
   void commit(const Plan& plan);

@@ -272,8 +272,6 @@ class SeifSlam {
   using Reacquisition = PoseReacquisition<Space, Sensor, State, X>;
   using Recovery = LostPoseRecovery<SeifSlam, Reacquisition>;
   friend Recovery;
-  /// A candidate that won its probation: its estimate replaces this one's.
-  void adopt_estimate(SeifSlam&& candidate);
   std::vector<typename Reacquisition::Sighting> rejected_sightings(std::span<const ObservationType> observations,
                                                                    const UpdateResult& result) const;
   std::optional<NewLandmark> new_landmark(const ObservationType& observation, std::vector<LandmarkId>& unusable) const;

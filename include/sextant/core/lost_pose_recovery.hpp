@@ -5,8 +5,8 @@
 /// switch to the copy when it wins. The filter provides, to this class as a friend:
 ///   std::vector<Sighting> rejected_sightings(observations, const UpdateResult&) const;
 ///   void reacquire_pose(const Offset& d);  // the pose moved by d, d d^T added to its covariance
-///   a member `recovery_` of this type (the copy's is switched off);
-/// and takes a winning candidate's estimate itself (follow_up returns it).
+///   a member `recovery_` of this type (the copy's is switched off).
+/// after_update runs follow_up and has the filter take a winning candidate's estimate.
 
 #include <exception>
 #include <memory>
@@ -83,6 +83,17 @@ class LostPoseRecovery {
       record_.forget_record();
     }
     return nullptr;
+  }
+
+  /// follow_up on `filter`'s own recovery; a winning candidate's estimate replaces the filter's,
+  /// whose re-acquisition record stays its own. Never throws (moves only).
+  template <class Observation>
+  static void after_update(Filter& filter, std::span<const Observation> observations, UpdateResult& result) noexcept {
+    auto winner = filter.recovery_.follow_up(filter, observations, result);
+    if (!winner) return;
+    LostPoseRecovery own = std::move(filter.recovery_);
+    filter = std::move(*winner);
+    filter.recovery_ = std::move(own);
   }
 
  private:

@@ -17,14 +17,6 @@ void EkfSlam<Motion, Sensor>::reacquire_pose(const Eigen::Matrix<double, X, 1>& 
   x_ = moved;
 }
 
-template <class Motion, class Sensor>
-void EkfSlam<Motion, Sensor>::adopt_estimate(EkfSlam&& candidate) {
-  x_ = candidate.x_;
-  propagated_ = candidate.propagated_;
-  landmarks_ = std::move(candidate.landmarks_);
-  cov_ = std::move(candidate.cov_);
-}
-
 /// The update's rejected sightings as the re-acquisition test reads them: each with the robot's
 /// estimate, the landmark's mean and S = J_m P_m J_m^T + Q. One the model cannot predict is left out.
 template <class Motion, class Sensor>

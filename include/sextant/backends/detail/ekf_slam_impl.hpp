@@ -55,7 +55,7 @@ void EkfSlam<Motion, Sensor>::predict(const Control& u, double dt) {
 template <class Motion, class Sensor>
 UpdateResult EkfSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
   UpdateResult result = correct_and_augment(observations);
-  if (auto winner = recovery_.follow_up(*this, observations, result)) adopt_estimate(std::move(*winner));
+  Recovery::after_update(*this, observations, result);
   return result;
 }
 

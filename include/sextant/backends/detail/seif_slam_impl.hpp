@@ -229,7 +229,7 @@ std::vector<std::size_t> SeifSlam<Motion, Sensor>::add_step(const std::vector<Me
 template <class Motion, class Sensor>
 UpdateResult SeifSlam<Motion, Sensor>::update(std::span<const ObservationType> observations) {
   UpdateResult result = update_information(observations);
-  if (auto winner = recovery_.follow_up(*this, observations, result)) adopt_estimate(std::move(*winner));
+  Recovery::after_update(*this, observations, result);
   return result;
 }
 
@@ -1033,14 +1033,6 @@ std::vector<LandmarkId> SeifSlam<Motion, Sensor>::active_landmarks() const {
   std::vector<LandmarkId> out;
   for (std::size_t slot : active_queue_) out.push_back(landmarks_.id_at(slot));
   return out;
-}
-
-/// Everything but the re-acquisition's own record, which stays this filter's.
-template <class Motion, class Sensor>
-void SeifSlam<Motion, Sensor>::adopt_estimate(SeifSlam&& candidate) {
-  Recovery recovery = std::move(recovery_);
-  *this = std::move(candidate);
-  recovery_ = std::move(recovery);
 }
 
 /// The update's rejected sightings as the re-acquisition test reads them: each with the robot's
