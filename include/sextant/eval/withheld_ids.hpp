@@ -5,54 +5,35 @@
 /// that created it, so a run with unknown correspondences is scored like one with known ids.
 
 #include <span>
-#include <vector>
 
 #include "sextant/core/data_association.hpp"
-#include "sextant/core/update_result.hpp"
-#include "sextant/eval/association_score.hpp"
+#include "sextant/eval/withheld_ids_run.hpp"
 
 namespace sextant::eval {
 
 template <class Backend, class Sensor>
-class WithheldIds {
+class WithheldIds : public WithheldIdsRun<WithheldIds<Backend, Sensor>, Backend> {
+  using Run = WithheldIdsRun<WithheldIds, Backend>;
+
  public:
-  using State = typename Backend::State;
-  using Control = typename Backend::Control;
-  using Space = typename Backend::Space;
-  using ObservationType = typename Backend::ObservationType;
+  using typename Run::ObservationType;
   using Measurement = typename Sensor::Measurement;
 
   WithheldIds(Backend& backend, Sensor sensor, AssociationOptions options)
-      : backend_(backend), association_(std::move(sensor), options) {}
+      : Run(backend), association_(std::move(sensor), options) {}
 
-  void predict(const Control& u, double dt) { backend_.predict(u, dt); }
-
+  using Run::update;
   /// Associates the measurements (their ids are used only to score the association), then updates.
   UpdateResult update(std::span<const ObservationType> observations) {
     const auto step = withhold_ids(observations);
-    const auto result = association_.associate(backend_, std::span<const Measurement>(step.z));
-    const UpdateResult update = backend_.update(result.observations);
-    score_.record(std::span<const LandmarkId>(step.truth), result);
+    const auto result = association_.associate(this->backend_, std::span<const Measurement>(step.z));
+    const UpdateResult update = this->backend_.update(result.observations);
+    this->score_.record(std::span<const LandmarkId>(step.truth), result);
     return update;
   }
-  UpdateResult update(const std::vector<ObservationType>& observations) { return update(std::span(observations)); }
-
-  auto pose() const { return backend_.pose(); }
-  /// The back-end's map, each landmark under the true id of the measurement that created it.
-  auto map() const {
-    auto map = backend_.map();
-    for (auto& landmark : map) landmark.id = score_.truth_of(landmark.id).value_or(landmark.id);
-    return map;
-  }
-  /// Removes a landmark by the id the association gave it.
-  void remove_landmark(LandmarkId id) { backend_.remove_landmark(id); }
-
-  const AssociationScore& score() const { return score_; }
 
  private:
-  Backend& backend_;
   DataAssociation<Sensor> association_;
-  AssociationScore score_;
 };
 
 }  // namespace sextant::eval
