@@ -52,10 +52,12 @@ void require_process_noise(const Eigen::MatrixBase<Derived>& R) {
   const double tolerance = 1e-9 * scale;
   if (!((R - R.transpose()).cwiseAbs().maxCoeff() <= tolerance))
     throw numerical_error("process noise R is not symmetric");
-  const typename Derived::PlainObject symmetric = 0.5 * (R + R.transpose());
-  const double smallest = Eigen::SelfAdjointEigenSolver<typename Derived::PlainObject>(symmetric, Eigen::EigenvaluesOnly)
-                              .eigenvalues()
-                              .minCoeff();
+  using Matrix = typename Derived::PlainObject;
+  const Matrix symmetric = 0.5 * (R + R.transpose());
+  // R + tolerance I has a Cholesky factor iff R's smallest eigenvalue is above -tolerance (to
+  // rounding): the common case at the cost of a factorization; the eigenvalues only otherwise.
+  if (Eigen::LLT<Matrix>(symmetric + tolerance * Matrix::Identity(R.rows(), R.cols())).info() == Eigen::Success) return;
+  const double smallest = Eigen::SelfAdjointEigenSolver<Matrix>(symmetric, Eigen::EigenvaluesOnly).eigenvalues().minCoeff();
   if (!(smallest >= -tolerance))
     throw numerical_error("process noise R is not positive semi-definite (smallest eigenvalue " +
                           std::to_string(smallest) + ")");
