@@ -11,6 +11,7 @@
 #include <exception>
 #include <memory>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "sextant/core/error.hpp"
@@ -89,6 +90,7 @@ class LostPoseRecovery {
   /// whose re-acquisition record stays its own. Never throws (moves only).
   template <class Observation>
   static void after_update(Filter& filter, std::span<const Observation> observations, UpdateResult& result) noexcept {
+    static_assert(std::is_nothrow_move_assignable_v<Filter>, "taking the winner's estimate must not throw");
     auto winner = filter.recovery_.follow_up(filter, observations, result);
     if (!winner) return;
     LostPoseRecovery own = std::move(filter.recovery_);

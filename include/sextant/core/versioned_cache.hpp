@@ -2,7 +2,9 @@
 /// \file A value computed on demand from an estimator's state and kept until the state changes:
 /// the estimator bumps a version on every change, get(version, make) recomputes when they differ.
 /// Safe for const methods called from several threads at once (a mutex guards the slot; the
-/// value is shared, so a reader keeps its copy alive while another thread replaces it).
+/// value is shared, so a reader keeps its copy alive while another thread replaces it). A move,
+/// like any write to the estimator that holds the cache, must not race with its readers: it takes
+/// the value without the lock and cannot throw.
 
 #include <cstdint>
 #include <memory>
@@ -24,6 +26,12 @@ class VersionedCache {
       value_ = std::move(value);
       version_ = version;
     }
+    return *this;
+  }
+  VersionedCache(VersionedCache&& other) noexcept : value_(std::move(other.value_)), version_(other.version_) {}
+  VersionedCache& operator=(VersionedCache&& other) noexcept {
+    value_ = std::move(other.value_);
+    version_ = other.version_;
     return *this;
   }
 
