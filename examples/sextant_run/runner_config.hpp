@@ -667,6 +667,10 @@ inline std::vector<ConfigKey> seif_keys() {
     {"seif", "relocalization_min_information", "0.05",
      "relocalization: share of the robot's information the held-back measurements must carry in every direction",
      [](RunnerConfig& c, const std::string& v) { c.seif.relocalization_min_information = non_negative(parse_number(v), v); }},
+    {"seif", "relocalization_active_bound", "0",
+     "relocalization: past this many active landmarks, held-back measurements that determine the pose at all relocalize it "
+     "(a bounded step; the map pays: docs/results/seif_relocalization.md; 0 = no bound)",
+     [](RunnerConfig& c, const std::string& v) { c.seif.relocalization_active_bound = parse_integer<std::size_t>(v, 0, 1e6); }},
     {"seif", "mean_recovery", "active_block", "active_block (joint solve) | coordinate_descent (thesis)",
      [](RunnerConfig& c, const std::string& v) {
        c.seif.mean_recovery = parse_choice<MeanRecovery>(

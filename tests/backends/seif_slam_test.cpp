@@ -297,6 +297,57 @@ TEST(SeifSlam, RelocalizationHoldsBackMoreThanMaxActiveWhenTheyDoNotCarryEnough)
   EXPECT_EQ(seif.relocalizations(), 5u);  // and the active set never grows to every landmark again
 }
 
+/// When no step's measurements carry relocalization_min_information (here none ever can), the active
+/// set overflows only up to relocalization_active_bound: past it, any held-back set that determines
+/// the pose relocalizes it. Without the bound the robot stays linked to every landmark it has seen
+/// (Victoria Park: all 151 trees, an EKF's cost per step). Forced or not, relocalization
+/// only discards information: the joint covariance stays at or above the exact one (the EKF's, a peer
+/// in the same loop; the ship is linear and Gaussian; 1e-9 of its scale is rounding).
+TEST(SeifSlam, RelocalizationBoundsTheActiveSetWhenNoStepCarriesEnough) {
+  const BeaconShip2D motion;
+  const BeaconOffset2D sensor;
+  constexpr std::size_t kMaxActive = 2, kSteps = 30;
+  const auto run = [&](std::size_t bound, Ekf* exact) {
+    Seif seif{motion, sensor, test::kLinearPrior,
+              {.max_active = kMaxActive, .sparsification = SeifSparsification::relocalization,
+               .relocalization_min_information = 1e6, .relocalization_active_bound = bound}};
+    std::size_t most_active = 0;
+    for (std::size_t k = 0; k < kSteps; ++k) {  // at rest, seeing landmarks k, k + 1, k + 2: one new a step
+      std::vector<Observation<Eigen::Vector2d>> frame;
+      for (std::size_t i = k; i < k + 3; ++i) frame.push_back({i + 1, Eigen::Vector2d(2.0 * double(i) - 20.0, 5.0)});
+      seif.predict(Eigen::Vector2d::Zero(), 1.0);
+      seif.update(frame);
+      if (exact) exact->predict(Eigen::Vector2d::Zero(), 1.0), exact->update(frame);
+      most_active = std::max(most_active, seif.active_landmarks().size());
+    }
+    return std::pair{most_active, std::move(seif)};
+  };
+  const auto [unbounded_most, unbounded] = run(0, nullptr);
+  EXPECT_EQ(unbounded.relocalizations(), 0u);
+  EXPECT_EQ(unbounded_most, kSteps + 2);  // linked to every landmark seen
+  Ekf ekf{motion, sensor, test::kLinearPrior};
+  const auto [most, seif] = run(2 * kMaxActive, &ekf);
+  EXPECT_LE(most, 2 * kMaxActive);
+  EXPECT_GT(seif.relocalizations(), 5u);
+  const std::vector<LandmarkId> ids = ekf.landmark_ids();
+  const Eigen::MatrixXd exact = joint_covariance_of(ekf, ids);
+  const double scale = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(exact, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  const Eigen::MatrixXd excess = joint_covariance_of(seif, ids) - exact;
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(excess, Eigen::EigenvaluesOnly).eigenvalues().minCoeff() / scale, -1e-9);
+}
+
+TEST(SeifSlam, RelocalizationBoundBelowMaxActiveIsNamed) {
+  const BeaconShip2D motion;
+  const BeaconOffset2D sensor;
+  try {
+    Seif seif{motion, sensor, test::kLinearPrior,
+              {.max_active = 8, .sparsification = SeifSparsification::relocalization, .relocalization_active_bound = 4}};
+    FAIL() << "a bound below max_active was accepted";
+  } catch (const invalid_input_error& e) {
+    EXPECT_NE(std::string(e.what()).find("relocalization_active_bound"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SeifSlam, TheExactMeanEstimateIsTheMeanAnExactRecoveryMovesTo) {
   const auto data = sim::simulate_ship_2d({.seed = 3, .num_steps = 200});
   for (auto sparsification : {SeifSparsification::thesis, SeifSparsification::relocalization}) {

@@ -6,6 +6,7 @@
 #include <Eigen/SparseCore>
 #include <chrono>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -80,6 +81,15 @@ struct SeifOptions {
   /// chose 0.05 (at most 20x less information, 4.5x the standard deviation) is in
   /// docs/results/seif_relocalization.md.
   double relocalization_min_information = 0.05;
+  /// Relocalization only: a bound on that overflow, for a step cost that stays bounded. When the
+  /// update would leave more than this many landmarks linked to the robot, the max_active most
+  /// informative held-back measurements relocalize it as soon as they determine the pose at all (full
+  /// rank, conditioned), however little of its information they carry. Without it, data that see a
+  /// few landmarks at a time (Victoria Park's 0-3 trees a step) may never relocalize, and the robot
+  /// ends linked to the whole map at an EKF's cost per step; with it, the map pays for the weak
+  /// relocalizations (every log of docs/results/simul_landmarks.md measured with 2x and 8x
+  /// max_active in docs/results/seif_relocalization.md, "A bound on the overflow"). 0 = no bound.
+  std::size_t relocalization_active_bound = 0;
   /// Relocalization of a robot whose motion model has a tail no measurement sees
   /// (kConditionallyLinearDims = T, e.g. the 12D camera's velocities): the covariance (T x T) the
   /// relocalized tail gets, centred at its current mean and linked to nothing. Empty (the default):
@@ -351,7 +361,8 @@ class SeifSlam {
   /// ESEIF: the observations to relocalize the robot from, taken out of `observations`, when the
   /// update would leave more than max_active landmarks linked to the robot: max_active of them, or
   /// as many more as carry relocalization_min_information (none when all of them do not: the active
-  /// set then overflows until a step can relocalize).
+  /// set then overflows until a step can relocalize, up to relocalization_active_bound(), past
+  /// which any set that determines the pose will do).
   std::vector<MeasurementInformation> hold_back_for_relocalization(std::vector<MeasurementInformation>& observations,
                                                                    std::size_t new_landmarks) const;
   std::vector<Eigen::Matrix<double, X, X>> information_about_robot(const std::vector<MeasurementInformation>& observations) const;
@@ -363,7 +374,14 @@ class SeifSlam {
                                     std::vector<Eigen::Matrix<double, X, X>>& about_robot, std::size_t k,
                                     Eigen::Matrix<double, X, X>& chosen);
   bool carries_enough(const Eigen::Matrix<double, X, X>& chosen,
-                      const Eigen::Matrix<double, X - kUnseenTail, X - kUnseenTail>& reference) const;
+                      const Eigen::Matrix<double, X - kUnseenTail, X - kUnseenTail>& reference, double share) const;
+  /// carries_enough's share when any held-back set that determines the pose will do.
+  static constexpr double kAnyShare = -std::numeric_limits<double>::infinity();
+  /// SeifOptions::relocalization_active_bound, 0 read as none.
+  std::size_t relocalization_active_bound() const {
+    return options_.relocalization_active_bound != 0 ? options_.relocalization_active_bound
+                                                     : std::numeric_limits<std::size_t>::max();
+  }
   /// Omega' = Omega_mm - Omega_mx Omega_xx^-1 Omega_xm and r' likewise, over the active landmarks
   /// only; leaves the robot with no information and no links.
   void marginalize_robot();

@@ -28,6 +28,8 @@ SeifSlam<Motion, Sensor>::SeifSlam(Motion motion, Sensor sensor, const PoseEstim
   info_.robot() = inverse_of_spd_or_throw(prior.cov, "prior covariance");
   if (!(options_.relocalization_min_information >= 0.0) || !std::isfinite(options_.relocalization_min_information))
     throw invalid_input_error("SeifOptions: relocalization_min_information must be finite and >= 0");
+  if (options_.relocalization_active_bound != 0 && options_.relocalization_active_bound < options_.max_active)
+    throw invalid_input_error("SeifOptions: relocalization_active_bound must be 0 (no bound) or at least max_active");
   if (options_.mean_recovery_sweeps < 0 || options_.exact_recovery_period < 0)
     throw invalid_input_error("SeifOptions: mean_recovery_sweeps and exact_recovery_period must be >= 0");
   if (options_.iterations < 1)
@@ -681,7 +683,10 @@ auto SeifSlam<Motion, Sensor>::hold_back_for_relocalization(std::vector<Measurem
   std::unordered_set<std::size_t> active;
   for (const auto& [slot, block] : info_.robot_links()) active.insert(slot);
   for (const auto& info : observations) active.insert(info.slot);
-  if (active.size() + new_landmarks <= options_.max_active || observations.empty()) return {};
+  const std::size_t linked = active.size() + new_landmarks;
+  if (linked <= options_.max_active || observations.empty()) return {};
+  // Past the bound, a set that determines the pose at all will do.
+  const double share = linked > relocalization_active_bound() ? kAnyShare : options_.relocalization_min_information;
   std::vector<MatrixX> about_robot = information_about_robot(observations);
   MatrixX total = MatrixX::Zero();
   for (const auto& lambda : about_robot) total += lambda;
@@ -690,14 +695,14 @@ auto SeifSlam<Motion, Sensor>::hold_back_for_relocalization(std::vector<Measurem
   const auto reference = seen_information_given_map();
   if (!reference) return {};
   const MatrixX regularizer = 1e-12 * total.trace() / X * MatrixX::Identity();  // log det defined from the first pick
-  if (!carries_enough(total + regularizer, *reference)) return {};  // then no subset does: information only adds
+  if (!carries_enough(total + regularizer, *reference, share)) return {};  // then no subset does: information only adds
   MatrixX chosen = regularizer;
   std::size_t count = 0;
   for (; count < observations.size(); ++count) {
-    if (count >= options_.max_active && carries_enough(chosen, *reference)) break;
+    if (count >= options_.max_active && carries_enough(chosen, *reference, share)) break;
     pick_most_informative(observations, about_robot, count, chosen);
   }
-  if (!carries_enough(chosen, *reference)) return {};  // all of them, summed in another order
+  if (!carries_enough(chosen, *reference, share)) return {};  // all of them, summed in another order
   const auto held_end = observations.begin() + static_cast<std::ptrdiff_t>(count);
   std::vector<MeasurementInformation> held(std::make_move_iterator(observations.begin()), std::make_move_iterator(held_end));
   observations.erase(observations.begin(), held_end);
@@ -721,16 +726,19 @@ void SeifSlam<Motion, Sensor>::pick_most_informative(std::vector<MeasurementInfo
   chosen += about_robot[k];
 }
 
-/// Whether the information `chosen` about the robot holds relocalization_min_information of
-/// `reference` (the robot's seen entries given the map) in every direction, and is well conditioned.
+/// Whether the information `chosen` about the robot holds `share` of `reference` (the robot's seen
+/// entries given the map) in every direction, and is well conditioned (with kAnyShare, only that).
 template <class Motion, class Sensor>
 bool SeifSlam<Motion, Sensor>::carries_enough(const Eigen::Matrix<double, X, X>& chosen,
-                                              const Eigen::Matrix<double, X - kUnseenTail, X - kUnseenTail>& reference) const {
+                                              const Eigen::Matrix<double, X - kUnseenTail, X - kUnseenTail>& reference,
+                                              double share) const {
   constexpr int P = X - kUnseenTail;
   using MatrixP = Eigen::Matrix<double, P, P>;
   const MatrixP seen = chosen.template topLeftCorner<P, P>();
-  const Eigen::GeneralizedSelfAdjointEigenSolver<MatrixP> relative(seen, reference, Eigen::EigenvaluesOnly);
-  if (!(relative.eigenvalues()(0) >= options_.relocalization_min_information)) return false;
+  if (share != kAnyShare) {
+    const Eigen::GeneralizedSelfAdjointEigenSolver<MatrixP> relative(seen, reference, Eigen::EigenvaluesOnly);
+    if (!(relative.eigenvalues()(0) >= share)) return false;
+  }
   const Eigen::SelfAdjointEigenSolver<MatrixP> eigen(seen, Eigen::EigenvaluesOnly);
   return eigen.eigenvalues()(0) > 1e-9 * eigen.eigenvalues()(P - 1);
 }
