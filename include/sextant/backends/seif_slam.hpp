@@ -87,7 +87,7 @@ struct SeifOptions {
   /// rank, conditioned), however little of its information they carry. Without it, data that see a
   /// few landmarks at a time (Victoria Park's 0-3 trees a step) may never relocalize, and the robot
   /// ends linked to the whole map at an EKF's cost per step; with it, the map pays for the weak
-  /// relocalizations (every log of docs/results/simul_landmarks.md measured with 2x and 8x
+  /// relocalizations (every log of docs/results/simul_landmarks.md measured with 2x, 4x and 8x
   /// max_active in docs/results/seif_relocalization.md, "A bound on the overflow"). 0 = no bound.
   std::size_t relocalization_active_bound = 0;
   /// Relocalization of a robot whose motion model has a tail no measurement sees
