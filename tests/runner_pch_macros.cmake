@@ -1,0 +1,32 @@
+# The configuration macros that sextant's headers test (those tested in an #if but #defined by no
+# header) must each be recorded in examples/sextant_run/build_configuration.hpp, which program_main.cpp
+# checks against the runner's precompiled header (docs/build_times.md, "A precompiled header for the
+# runner"): a macro it does not know could differ between the header and a program's units unseen.
+file(GLOB_RECURSE headers ${SOURCE_DIR}/include/*.hpp)
+file(GLOB runner_headers ${SOURCE_DIR}/examples/sextant_run/*.hpp)
+set(tested "")
+set(defined "")
+foreach(header ${headers} ${runner_headers})
+  file(STRINGS ${header} lines REGEX "^[ \t]*#[ \t]*(if|ifdef|ifndef|elif|define)[ \t(]")
+  foreach(line ${lines})
+    string(REGEX MATCHALL "SEXTANT_[A-Z0-9_]+" names "${line}")
+    if(line MATCHES "^[ \t]*#[ \t]*define[ \t]+(SEXTANT_[A-Z0-9_]+)")
+      list(APPEND defined ${CMAKE_MATCH_1})
+    else()
+      list(APPEND tested ${names})
+    endif()
+  endforeach()
+endforeach()
+list(REMOVE_DUPLICATES tested)
+if(defined)
+  list(REMOVE_ITEM tested ${defined})
+endif()
+file(READ ${SOURCE_DIR}/examples/sextant_run/build_configuration.hpp recorded)
+file(READ ${SOURCE_DIR}/examples/sextant_run/program_main.cpp checked)
+foreach(macro ${tested})
+  if(NOT recorded MATCHES "#ifdef ${macro}\n" OR NOT checked MATCHES "#ifdef ${macro}\n")
+    message(FATAL_ERROR "${macro} is tested by sextant's headers but not recorded in "
+                        "examples/sextant_run/build_configuration.hpp and checked in program_main.cpp")
+  endif()
+endforeach()
+message(STATUS "build_configuration.hpp records every configuration macro: ${tested}")
