@@ -6,10 +6,10 @@
 #include <sextant/eval/dead_reckoning.hpp>
 #include <sextant/eval/metrics.hpp>
 #include <sextant/io/mrclam_reader.hpp>
-#include <sextant/models/se2_world_frame.hpp>
 
 #include "dataset_registry.hpp"
 #include "dataset_runner.hpp"
+#include "planar_world_frame_runs.hpp"
 
 namespace sextant::runner {
 
@@ -69,32 +69,6 @@ eval::RunScores score_filter_given_map(const Dataset& data, const RunnerConfig& 
   return eval::scores_of(run, scoring.pose_dof, scoring.landmark_dof);
 }
 
-/// The run with the pose perturbed in the world frame (models/se2_world_frame.hpp): the same data,
-/// with the filters' Jacobians and covariances in the chart where first-estimate Jacobians keep the
-/// global pose unobservable (docs/results/mrclam.md). Only for the filters, which linearize once:
-/// GraphSLAM's Gauss-Newton steps in this chart turn far poses about the origin, and from dead
-/// reckoning it diverges (docs/derivations/se2_world_frame.md).
-io::LandmarkDataset<InWorldFrame<Unicycle>, SeenInWorldFrame<RangeBearing2D>> in_world_frame(const io::MrclamRun& data) {
-  io::LandmarkDataset<InWorldFrame<Unicycle>, SeenInWorldFrame<RangeBearing2D>> out;
-  out.path = data.path;
-  out.motion = InWorldFrame<Unicycle>(data.motion);
-  out.sensor = SeenInWorldFrame<RangeBearing2D>(data.sensor);
-  out.prior = sextant::in_world_frame(data.prior);
-  out.steps = data.steps;
-  out.true_poses = data.true_poses;
-  out.true_landmarks = data.true_landmarks;
-  out.ids = data.ids;
-  return out;
-}
-
-/// The chosen back-ends split into those run in the world chart (EKF, SEIF and ESEIF, if `world`) and the rest.
-std::pair<std::vector<BackendKind>, std::vector<BackendKind>> split_filters(const std::vector<BackendKind>& kinds, bool world) {
-  std::pair<std::vector<BackendKind>, std::vector<BackendKind>> out;
-  for (const BackendKind kind : kinds)
-    (world && (kind == BackendKind::ekf || kind == BackendKind::seif || kind == BackendKind::eseif) ? out.first : out.second).push_back(kind);
-  return out;
-}
-
 /// The config with the [mrclam] gate, re-acquisition and kernel set on the back-ends
 /// (RunnerConfig::mrclam_gate_probability); re-acquisition needs the gate. FastSLAM keeps its own
 /// [fastslam] gate (off by default): its cloud's predictive covariance is overconfident on this data
@@ -134,12 +108,8 @@ std::vector<TableRow> run_mrclam(const CliOptions& cli, const std::string& datas
                 name.c_str(), c.measurements, c.robot_sightings, c.unknown_barcodes, c.outside_run, c.repeated_in_step);
     print_warnings(data.implausible);
     print_dataset_header(name, data, "m");
-    const auto [filters, others] = split_filters(kinds, config.mrclam_filters_in_world_frame);
-    RunOptions plot_once = options;  // the plots of the directory are drawn after the second part
-    plot_once.plots = options.plots && others.empty();
-    auto part = run_dataset_rows(plot_once, name, in_world_frame(data), filters, config, "m");
-    const auto rest = run_dataset_rows(options, name, data, others, config, "m");
-    part.insert(part.end(), rest.begin(), rest.end());
+    const auto part =
+        run_rows_with_filters_in_world_frame(options, name, data, kinds, config, config.mrclam_filters_in_world_frame, "m");
     const auto drift = score_dead_reckoning(data);
     std::printf("dead reckoning at the first sighting (%.1f s): heading off by %.3f rad, which no back-end can see; "
                 "a back-end exact from then on has position RMSE %.3f m\n",
