@@ -104,7 +104,7 @@ struct AssociationSettings {
 
 /// A filter setting that `automatic` turns on where it helps, from the models (backend_factory.hpp):
 /// [ekf] and [seif] first_estimate_jacobians where the pose is perturbed in the world frame ([mrclam]
-/// filters_in_world_frame), the chart in which they keep the global pose unobservable (in the
+/// and [isam] filters_in_world_frame), the chart in which they keep the global pose unobservable (in the
 /// additive chart they would also need the motion Jacobian at first estimates, and alone they make
 /// the EKF worse, docs/results/mrclam.md); observability_constraints where the state space names the
 /// world's rigid motions (the globe's 12D camera, docs/derivations/observability_constraints.md).
@@ -137,6 +137,7 @@ struct RunnerConfig {
   VislamSettings vislam;
   io::MrclamOptions mrclam;
   bool mrclam_filters_in_world_frame = true;  ///< [mrclam] filters_in_world_frame
+  bool isam_filters_in_world_frame = true;    ///< [isam] filters_in_world_frame (docs/results/victoria_park.md)
   /// [mrclam] gate_probability and graph_robust_kernel: what docs/results/mrclam.md recommends for
   /// real robots (heavy-tailed outliers), set on the back-ends for MRCLAM runs whatever [ekf], [seif]
   /// gate_probability and [graph] robust_kernel say; FastSLAM keeps [fastslam] gate_probability.
@@ -506,6 +507,16 @@ inline std::vector<ConfigKey> rawlog_keys() {
   };
 }
 
+/// [isam]: planar data sets in the iSAM/GTSAM text format (cityTrees10000, Victoria Park).
+inline std::vector<ConfigKey> isam_keys() {
+  return {
+    {"isam", "filters_in_world_frame", "true",
+     "iSAM text files: EKF and SEIF perturb the pose in the world frame (with first-estimate Jacobians: no spurious "
+     "heading information); GraphSLAM and FastSLAM keep the additive chart",
+     [](RunnerConfig& c, const std::string& v) { c.isam_filters_in_world_frame = parse_bool(v); }},
+  };
+}
+
 /// [mrclam]: the UTIAS MRCLAM robots.
 inline std::vector<ConfigKey> mrclam_keys() {
   constexpr double deg = std::numbers::pi / 180.0;
@@ -808,7 +819,7 @@ inline const std::vector<ConfigKey>& config_keys() {
     std::vector<ConfigKey> all;
     for (const auto& section : {detail::ship_keys(), detail::globe_keys(), detail::globe_stereo_keys(),
                                 detail::globe_stereo_association_keys(), detail::globe_graph_keys(),
-                                detail::vislam_keys(), detail::rawlog_keys(), detail::mrclam_keys(),
+                                detail::vislam_keys(), detail::rawlog_keys(), detail::isam_keys(), detail::mrclam_keys(),
                                 detail::association_keys(), detail::ekf_keys(), detail::seif_robustness_keys(),
                                 detail::seif_keys(), detail::graph_keys(), detail::pose_graph_keys(), detail::fastslam_keys(),
                                 detail::scene_keys()})

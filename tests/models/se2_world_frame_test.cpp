@@ -4,7 +4,9 @@
 
 #include <random>
 
+#include "sextant/models/point_in_robot_frame_2d.hpp"
 #include "sextant/models/range_bearing_2d.hpp"
+#include "sextant/models/se2_odometry.hpp"
 #include "sextant/models/unicycle.hpp"
 #include "sextant/testing/model_checks.hpp"
 
@@ -15,6 +17,11 @@ using WorldUnicycle = InWorldFrame<Unicycle>;
 using WorldRangeBearing = SeenInWorldFrame<RangeBearing2D>;
 static_assert(HasBetweenFactor<WorldUnicycle>);
 static_assert(MeasurementModelFor<WorldRangeBearing, WorldUnicycle>);
+// The iSAM text files' pair (sextant-run's [isam] filters_in_world_frame).
+using WorldOdometry = InWorldFrame<Se2Odometry>;
+using WorldPoint = SeenInWorldFrame<PointInRobotFrame2D>;
+static_assert(HasBetweenFactor<WorldOdometry>);
+static_assert(MeasurementModelFor<WorldPoint, WorldOdometry>);
 
 /// Random poses far from the origin (the world chart's lever arm) and landmarks around them.
 std::vector<Eigen::Vector3d> random_poses(std::mt19937_64& rng) {
@@ -61,6 +68,26 @@ TEST(Se2WorldFrame, JacobiansMatchCentralDifferencesInTheWorldChart) {
   }
 }
 
+TEST(Se2WorldFrame, OdometryAndPointJacobiansMatchCentralDifferencesInTheWorldChart) {
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> offset(-6.0, 6.0);
+  Eigen::Matrix3d cov;
+  cov << 0.04, 0.01, 0.002, 0.01, 0.09, -0.003, 0.002, -0.003, 0.01;  // correlated, as the files' records
+  for (const auto& x : random_poses(rng)) {
+    for (const Eigen::Vector3d delta : {Eigen::Vector3d(1.0, 0.0, 0.0), Eigen::Vector3d(0.7, -0.2, 0.4)}) {
+      const OdometryIncrement2D u{delta, cov};
+      const auto motion = testing::check_motion_jacobians(WorldOdometry{}, x, u, 1.0);
+      EXPECT_TRUE(motion) << motion.report;
+      const Eigen::Vector3d to = WorldOdometry{}.predict(x, u, 1.0).x + Eigen::Vector3d(0.02, -0.01, 0.03);
+      const auto between = testing::check_between_jacobians(WorldOdometry{}, x, to, u, 1.0);
+      EXPECT_TRUE(between) << between.report;
+    }
+    const Eigen::Vector2d m = x.head<2>() + Eigen::Vector2d(offset(rng), offset(rng));
+    const auto measurement = testing::check_measurement_jacobians<WorldOdometry>(WorldPoint{}, x, m);
+    EXPECT_TRUE(measurement) << measurement.report;
+  }
+}
+
 /// The properties the filter relies on: a body-frame motion has the Jacobian I in this chart, and a
 /// measurement Jacobian annihilates the global translation and rotation (rho, phi) that moves the
 /// pose by (rho, phi) and the landmark by rho + phi J m, whatever the robot's estimate.
@@ -79,6 +106,15 @@ TEST(Se2WorldFrame, MotionJacobianIsIdentityAndMeasurementsSeeNoGlobalMotion) {
       const Eigen::Vector3d robot = Eigen::Vector3d::Unit(i);
       const Eigen::Vector2d landmark = robot.head<2>() + robot(2) * J * m;
       EXPECT_LT((p.J_z_x * robot + p.J_z_m * landmark).norm(), 1e-12) << "direction " << i;
+    }
+    // The same for the iSAM files' odometry and points seen in the robot frame.
+    EXPECT_TRUE(WorldOdometry{}.predict(x, {Eigen::Vector3d(0.8, 0.1, -0.3), Eigen::Matrix3d::Identity()}, 1.0)
+                    .J_x_x.isIdentity(1e-12));
+    const auto q = WorldPoint{}.predict(x, m);
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector3d robot = Eigen::Vector3d::Unit(i);
+      const Eigen::Vector2d landmark = robot.head<2>() + robot(2) * J * m;
+      EXPECT_LT((q.J_z_x * robot + q.J_z_m * landmark).norm(), 1e-12) << "direction " << i;
     }
   }
 }

@@ -1,11 +1,13 @@
 // sextant-run's iSAM part: every chosen back-end, filters included, on a planar data set in the
 // iSAM/GTSAM text format (--dataset <file.txt>: cityTrees10000, Victoria Park); scored when a
-// noise-free <name>_groundtruth.txt lies beside it, otherwise timed and written out only.
+// noise-free <name>_groundtruth.txt lies beside it, otherwise timed and written out only. The
+// filters run in the world chart ([isam] filters_in_world_frame, planar_world_frame_runs.hpp).
 #include <filesystem>
 #include <sextant/io/isam_dataset.hpp>
 
 #include "dataset_registry.hpp"
 #include "dataset_runner.hpp"
+#include "planar_world_frame_runs.hpp"
 
 namespace sextant::runner {
 
@@ -19,7 +21,12 @@ std::vector<TableRow> run_isam(const CliOptions& cli, const std::string& path, c
   std::printf("\n%s: %zu steps, %zu landmark sightings%s\n", path.c_str(), data.steps.size(), sightings,
               data.has_ground_truth() ? "" : "; no ground truth beside it: the runs are timed and written out, not scored");
   print_warnings(data.implausible);
-  return run_dataset(cli.output, std::filesystem::path(path).filename().string(), data, kinds, config, "m");
+  if (config.isam_filters_in_world_frame)
+    std::printf("EKF, SEIF and ESEIF perturb the pose in the world frame ([isam] filters_in_world_frame), where "
+                "first-estimate Jacobians keep the global heading unobservable\n");
+  const std::string name = std::filesystem::path(path).filename().string();
+  print_dataset_header(name, data, "m");
+  return run_rows_with_filters_in_world_frame(cli.output, name, data, kinds, config, config.isam_filters_in_world_frame, "m");
 }
 
 const RegisterDatasetRun registration{"isam", run_isam};

@@ -66,6 +66,24 @@ extern template class sextant::GraphSlam<sextant::Se2Odometry, sextant::PointInR
 extern template class sextant::FastSlam<sextant::Se2Odometry, sextant::PointInRobotFrame2D>;
 #endif
 
+// InWorldFrame<Se2Odometry> x SeenInWorldFrame<PointInRobotFrame2D>
+#if defined(SEXTANT_DECLARED_EKF_SLAM) && defined(SEXTANT_DECLARED_SE2_ODOMETRY) && defined(SEXTANT_DECLARED_POINT_IN_ROBOT_FRAME_2D) && defined(SEXTANT_DECLARED_SE2_WORLD_FRAME) && !defined(SEXTANT_EXTERN_EKF_SLAM_ISAM_2D_WORLD)
+#define SEXTANT_EXTERN_EKF_SLAM_ISAM_2D_WORLD
+extern template class sextant::EkfSlam<sextant::InWorldFrame<sextant::Se2Odometry>, sextant::SeenInWorldFrame<sextant::PointInRobotFrame2D>>;
+#endif
+#if defined(SEXTANT_DECLARED_SEIF_SLAM) && defined(SEXTANT_DECLARED_SE2_ODOMETRY) && defined(SEXTANT_DECLARED_POINT_IN_ROBOT_FRAME_2D) && defined(SEXTANT_DECLARED_SE2_WORLD_FRAME) && !defined(SEXTANT_EXTERN_SEIF_SLAM_ISAM_2D_WORLD)
+#define SEXTANT_EXTERN_SEIF_SLAM_ISAM_2D_WORLD
+extern template class sextant::SeifSlam<sextant::InWorldFrame<sextant::Se2Odometry>, sextant::SeenInWorldFrame<sextant::PointInRobotFrame2D>>;
+#endif
+#if defined(SEXTANT_DECLARED_GRAPH_SLAM) && defined(SEXTANT_DECLARED_SE2_ODOMETRY) && defined(SEXTANT_DECLARED_POINT_IN_ROBOT_FRAME_2D) && defined(SEXTANT_DECLARED_SE2_WORLD_FRAME) && !defined(SEXTANT_EXTERN_GRAPH_SLAM_ISAM_2D_WORLD)
+#define SEXTANT_EXTERN_GRAPH_SLAM_ISAM_2D_WORLD
+extern template class sextant::GraphSlam<sextant::InWorldFrame<sextant::Se2Odometry>, sextant::SeenInWorldFrame<sextant::PointInRobotFrame2D>>;
+#endif
+#if defined(SEXTANT_DECLARED_FAST_SLAM) && defined(SEXTANT_DECLARED_SE2_ODOMETRY) && defined(SEXTANT_DECLARED_POINT_IN_ROBOT_FRAME_2D) && defined(SEXTANT_DECLARED_SE2_WORLD_FRAME) && !defined(SEXTANT_EXTERN_FAST_SLAM_ISAM_2D_WORLD)
+#define SEXTANT_EXTERN_FAST_SLAM_ISAM_2D_WORLD
+extern template class sextant::FastSlam<sextant::InWorldFrame<sextant::Se2Odometry>, sextant::SeenInWorldFrame<sextant::PointInRobotFrame2D>>;
+#endif
+
 // Se3Odometry x RangeBearing3D
 #if defined(SEXTANT_DECLARED_EKF_SLAM) && defined(SEXTANT_DECLARED_SE3_ODOMETRY) && defined(SEXTANT_DECLARED_RANGE_BEARING_3D) && !defined(SEXTANT_EXTERN_EKF_SLAM_RAWLOG_3D)
 #define SEXTANT_EXTERN_EKF_SLAM_RAWLOG_3D
