@@ -14,13 +14,17 @@ namespace sextant::runner {
 namespace {
 
 std::vector<TableRow> run_isam(const CliOptions& cli, const std::string& path, const std::vector<BackendKind>& kinds,
-                               const RunnerConfig& config) {
+                               const RunnerConfig& settings) {
+  RunnerConfig config = settings;
+  config.graph.window = settings.isam_graph_window;
   const auto data = io::read_isam_dataset(path);
   std::size_t sightings = 0;
   for (const auto& step : data.steps) sightings += step.observations.size();
   std::printf("\n%s: %zu steps, %zu landmark sightings%s\n", path.c_str(), data.steps.size(), sightings,
               data.has_ground_truth() ? "" : "; no ground truth beside it: the runs are timed and written out, not scored");
   print_warnings(data.implausible);
+  if (config.graph.window > 0)
+    std::printf("GraphSLAM starts from a windowed initialization of %zu steps ([isam] graph_window)\n", config.graph.window);
   if (config.isam_filters_in_world_frame)
     std::printf("EKF, SEIF and ESEIF perturb the pose in the world frame ([isam] filters_in_world_frame), where "
                 "first-estimate Jacobians keep the global heading unobservable\n");
