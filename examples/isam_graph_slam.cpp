@@ -4,16 +4,19 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
+#include <sextant/io/isam_dataset.hpp>
 #include <sextant/sextant.hpp>
 
 int main(int argc, char** argv) {
   using namespace sextant;
   CLI::App app{"sextant: GraphSLAM on an iSAM-format planar data set"};
-  std::string path, noise = "sqrt", out_dir;
+  std::string path, noise = "auto", out_dir;
   GraphOptions options;
   app.add_option("file", path, "data file (EDGE2/ODOMETRY and LANDMARK records)")->required()->check(CLI::ExistingFile);
-  app.add_option("--noise", noise, "noise values: sqrt (square-root information, iSAM) or cov (covariance, GTSAM)")
-      ->check(CLI::IsMember({"sqrt", "cov"}))
+  app.add_option("--noise", noise,
+                 "noise values: sqrt (square-root information, iSAM), cov (covariance, GTSAM) or auto (read off the first "
+                 "odometry record: EDGE2 sqrt, ODOMETRY cov)")
+      ->check(CLI::IsMember({"auto", "sqrt", "cov"}))
       ->capture_default_str();
   app.add_option("--window", options.window, "windowed initialization: steps per sub-part (0 = dead reckoning)")
       ->capture_default_str();
@@ -21,7 +24,10 @@ int main(int argc, char** argv) {
   app.add_option("--out", out_dir, "directory for poses.csv and landmarks.csv");
   CLI11_PARSE(app, argc, argv);
   try {
-    const auto data = io::read_isam_2d(path, noise == "cov" ? io::IsamNoise::covariance : io::IsamNoise::square_root_information);
+    const io::IsamNoise form = noise == "auto" ? io::detect_isam_noise(path)
+                               : noise == "cov"  ? io::IsamNoise::covariance
+                                                 : io::IsamNoise::square_root_information;
+    const auto data = io::read_isam_2d(path, form);
     PointInRobotFrame2D sensor;
     sensor.Q = data.landmark_cov;
     GraphSlam<Se2Odometry, PointInRobotFrame2D> graph{Se2Odometry{}, sensor,
