@@ -74,7 +74,7 @@ TEST(Se2WorldFrame, OdometryAndPointJacobiansMatchCentralDifferencesInTheWorldCh
   Eigen::Matrix3d cov;
   cov << 0.04, 0.01, 0.002, 0.01, 0.09, -0.003, 0.002, -0.003, 0.01;  // correlated, as the files' records
   for (const auto& x : random_poses(rng)) {
-    for (const Eigen::Vector3d delta : {Eigen::Vector3d(1.0, 0.0, 0.0), Eigen::Vector3d(0.7, -0.2, 0.4)}) {
+    for (const Eigen::Vector3d& delta : {Eigen::Vector3d(1.0, 0.0, 0.0), Eigen::Vector3d(0.7, -0.2, 0.4)}) {
       const OdometryIncrement2D u{delta, cov};
       const auto motion = testing::check_motion_jacobians(WorldOdometry{}, x, u, 1.0);
       EXPECT_TRUE(motion) << motion.report;
@@ -98,24 +98,21 @@ TEST(Se2WorldFrame, MotionJacobianIsIdentityAndMeasurementsSeeNoGlobalMotion) {
   sensor.sensor_pose << 0.1, -0.05, 0.2;
   Eigen::Matrix2d J;
   J << 0, -1, 1, 0;
+  auto expect_no_global_motion_seen = [&J](const auto& prediction, const Eigen::Vector2d& m, const char* sensor_name) {
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector3d robot = Eigen::Vector3d::Unit(i);
+      const Eigen::Vector2d landmark = robot.head<2>() + robot(2) * J * m;
+      EXPECT_LT((prediction.J_z_x * robot + prediction.J_z_m * landmark).norm(), 1e-12) << sensor_name << ", direction " << i;
+    }
+  };
   for (const auto& x : random_poses(rng)) {
     EXPECT_TRUE(WorldUnicycle{}.predict(x, {0.9, -0.7}, 0.3).J_x_x.isIdentity(1e-12));
     const Eigen::Vector2d m = x.head<2>() + Eigen::Vector2d(offset(rng), offset(rng));
-    const auto p = sensor.predict(x, m);
-    for (int i = 0; i < 3; ++i) {
-      const Eigen::Vector3d robot = Eigen::Vector3d::Unit(i);
-      const Eigen::Vector2d landmark = robot.head<2>() + robot(2) * J * m;
-      EXPECT_LT((p.J_z_x * robot + p.J_z_m * landmark).norm(), 1e-12) << "direction " << i;
-    }
+    expect_no_global_motion_seen(sensor.predict(x, m), m, "range-bearing");
     // The same for the iSAM files' odometry and points seen in the robot frame.
     EXPECT_TRUE(WorldOdometry{}.predict(x, {Eigen::Vector3d(0.8, 0.1, -0.3), Eigen::Matrix3d::Identity()}, 1.0)
                     .J_x_x.isIdentity(1e-12));
-    const auto q = WorldPoint{}.predict(x, m);
-    for (int i = 0; i < 3; ++i) {
-      const Eigen::Vector3d robot = Eigen::Vector3d::Unit(i);
-      const Eigen::Vector2d landmark = robot.head<2>() + robot(2) * J * m;
-      EXPECT_LT((q.J_z_x * robot + q.J_z_m * landmark).norm(), 1e-12) << "direction " << i;
-    }
+    expect_no_global_motion_seen(WorldPoint{}.predict(x, m), m, "point in the robot frame");
   }
 }
 
