@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# A speed goal measured as a ratio against a baseline in the same session (the project's rule: no
+# wall-clock goal is read off one machine): builds one Google Benchmark program from an older commit
+# and from this tree with the same compiler, runs the two in turn on one pinned core, and prints
+# each pair's times and ratio (older / this tree) and their spread.
+#
+#   benchmarks/against_commit.sh <commit> <program> <filter> [pairs]
+#   e.g. benchmarks/against_commit.sh 66d1e35 globe_benchmark 'BM_GlobeSeif120Steps/150/' 8
+#
+# The older tree is extracted with `git archive` to build-bench-<commit>/src and built in
+# build-bench-<commit>/build; this tree's program is built in build-bench (`./run.sh bench`'s).
+# SEXTANT_CXX chooses the compiler (default g++, as ./run.sh bench). The runs alternate, older
+# first, so that a machine whose speed drifts over the session (docs/benchmarks.md: a virtual
+# machine's memory handed back to its host) weighs on both sides alike; read the median.
+set -euo pipefail
+[ $# -ge 3 ] || { sed -n '6,7p' "$0" >&2; exit 2; }
+commit=$1 program=$2 filter=$3 pairs=${4:-6}
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+cxx=${SEXTANT_CXX:-g++}
+short=$(git rev-parse --short "$commit")
+old=$root/build-bench-$short
+jobs=$(nproc 2>/dev/null || echo 2)
+
+build() {  # build <source dir> <build dir>
+  [ -f "$2/CMakeCache.txt" ] || cmake -S "$1" -B "$2" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER="$cxx" \
+    -DSEXTANT_BUILD_BENCHMARKS=ON -DSEXTANT_BUILD_TESTS=OFF > /dev/null
+  cmake --build "$2" --target "$program" -j"$jobs" > "$2/against_commit_build.log" 2>&1 ||
+    { echo "against_commit: building $program in $2 failed: $2/against_commit_build.log" >&2; exit 1; }
+}
+if [ ! -d "$old/src" ]; then
+  mkdir -p "$old/src"
+  git archive "$commit" | tar -x -C "$old/src"
+fi
+echo "against_commit: building $program at $short and in this tree ($cxx)" >&2
+build "$old/src" "$old/build"
+build "$root" "${SEXTANT_BENCH_BUILD_DIR:-build-bench}"
+
+core=$(( $(nproc 2>/dev/null || echo 1) - 1 ))
+run() {  # run <program path> <json out>: one pinned run; prints its real time in s
+  if ! taskset -c "$core" "$1" --benchmark_filter="$filter" --benchmark_format=json > "$2" 2> "$2.err" || [ ! -s "$2" ]; then
+    echo "against_commit: $1 failed or no benchmark matches '$filter':" >&2
+    cat "$2.err" >&2
+    exit 1
+  fi
+  python3 -c 'import json,sys
+runs=[b for b in json.load(open(sys.argv[1]))["benchmarks"] if b.get("run_type","iteration")=="iteration"]
+scale={"s":1,"ms":1e-3,"us":1e-6,"ns":1e-9}
+print(" ".join("%.4f" % (b["real_time"] * scale[b["time_unit"]]) for b in runs))' "$2"
+}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+ratios=()
+for i in $(seq 1 "$pairs"); do
+  t_old=$(run "$old/build/benchmarks/$program" "$tmp/old.json")
+  t_new=$(run "${SEXTANT_BENCH_BUILD_DIR:-build-bench}/benchmarks/$program" "$tmp/new.json")
+  ratio=$(python3 -c "import sys; print(f'{float(sys.argv[1].split()[0]) / float(sys.argv[2].split()[0]):.2f}')" "$t_old" "$t_new")
+  echo "pair $i: $short ${t_old} s, this tree ${t_new} s, ratio ${ratio}x"
+  ratios+=("$ratio")
+done
+python3 -c 'import statistics,sys
+r=sorted(float(x) for x in sys.argv[1:])
+print(f"ratio over {len(r)} pairs: min {r[0]:.2f}x, median {statistics.median(r):.2f}x, max {r[-1]:.2f}x")' "${ratios[@]}"
