@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# A speed goal measured as a ratio against a baseline in the same session (the project's rule: no
-# wall-clock goal is read off one machine): builds one Google Benchmark program from an older commit
-# and from this tree with the same compiler, runs the two in turn on one pinned core, and prints
-# each pair's times and ratio (older / this tree) and their spread.
+# A speed goal measured as a ratio against a baseline in the same session (the project measures speed
+# as ratios against a peer or baseline run beside it, not as times read off one machine): builds one
+# Google Benchmark program from an older commit and from this tree with the same compiler, runs the
+# two in turn on one pinned core, and prints each pair's times and ratio (older / this tree: the
+# first benchmark the filter matches) and their spread.
 #
 #   benchmarks/against_commit.sh <commit> <program> <filter> [pairs]
 #   e.g. benchmarks/against_commit.sh 66d1e35 globe_benchmark 'BM_GlobeSeif120Steps/150/' 8
@@ -13,7 +14,7 @@
 # first, so that a machine whose speed drifts over the session (docs/benchmarks.md: a virtual
 # machine's memory handed back to its host) weighs on both sides alike; read the median.
 set -euo pipefail
-[ $# -ge 3 ] || { sed -n '6,7p' "$0" >&2; exit 2; }
+[ $# -ge 3 ] || { sed -n '8,9p' "$0" >&2; exit 2; }
 commit=$1 program=$2 filter=$3 pairs=${4:-6}
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
