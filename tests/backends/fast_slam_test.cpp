@@ -31,7 +31,7 @@ class FastVersions : public ::testing::TestWithParam<FastSlamVersion> {};
 struct KnownPoseLandmarkFilters {
   Eigen::Matrix2d Q;
   double dof = 0.0;
-  std::map<LandmarkId, std::pair<Eigen::Vector2d, Eigen::Matrix2d>> landmarks;
+  std::map<LandmarkId, std::pair<Eigen::Vector2d, Eigen::Matrix2d>> landmarks{};
 
   void add(const Eigen::Vector2d& x, const std::vector<Fast::ObservationType>& observations) {
     for (const auto& obs : observations) {

@@ -98,7 +98,7 @@ struct SeifOptions {
   /// lambda_max(Sigma_tt(k) Sigma_tail^-1), Sigma_tt(k) the tail's exact marginal covariance then
   /// (docs/derivations/seif_relocalization.md): small where the data have taught the filter the
   /// tail far better than the prior knew it.
-  Eigen::MatrixXd relocalization_tail_covariance;
+  Eigen::MatrixXd relocalization_tail_covariance{};
   SeifEstimate estimate = SeifEstimate::recovered_mean;
   MeanRecovery mean_recovery = MeanRecovery::active_block;
   int mean_recovery_sweeps = 1;   ///< sweeps per update (0 = none)
