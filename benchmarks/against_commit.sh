@@ -9,7 +9,8 @@
 #   e.g. benchmarks/against_commit.sh 66d1e35 globe_benchmark 'BM_GlobeSeif120Steps/150/' 8
 #
 # The older tree is extracted with `git archive` to build-bench-<commit>/src and built in
-# build-bench-<commit>/build; this tree's program is built in build-bench (`./run.sh bench`'s).
+# build-bench-<commit>/<compiler>; this tree's program is built in build-bench (`./run.sh bench`'s,
+# or SEXTANT_BENCH_BUILD_DIR), which must have been configured with the same compiler.
 # SEXTANT_CXX chooses the compiler (default g++, as ./run.sh bench). The runs alternate, older
 # first, so that a machine whose speed drifts over the session (docs/benchmarks.md: a virtual
 # machine's memory handed back to its host) weighs on both sides alike; read the median.
@@ -21,6 +22,8 @@ cd "$root"
 cxx=${SEXTANT_CXX:-g++}
 short=$(git rev-parse --short "$commit")
 old=$root/build-bench-$short
+old_build=$old/$(basename "$cxx")
+new_build=${SEXTANT_BENCH_BUILD_DIR:-build-bench}
 jobs=$(nproc 2>/dev/null || echo 2)
 
 build() {  # build <source dir> <build dir>
@@ -34,8 +37,14 @@ if [ ! -d "$old/src" ]; then
   git archive "$commit" | tar -x -C "$old/src"
 fi
 echo "against_commit: building $program at $short and in this tree ($cxx)" >&2
-build "$old/src" "$old/build"
-build "$root" "${SEXTANT_BENCH_BUILD_DIR:-build-bench}"
+build "$old/src" "$old_build"
+build "$root" "$new_build"
+compiler_of() { sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$1/CMakeCache.txt"; }
+if [ "$(compiler_of "$old_build")" != "$(compiler_of "$new_build")" ]; then
+  echo "against_commit: $new_build was configured with $(compiler_of "$new_build"), the older build with" \
+    "$(compiler_of "$old_build"): a ratio across compilers measures the compilers (SEXTANT_BENCH_BUILD_DIR names another build)" >&2
+  exit 1
+fi
 
 core=$(( $(nproc 2>/dev/null || echo 1) - 1 ))
 run() {  # run <program path> <json out>: one pinned run; prints its real time in s
@@ -53,8 +62,8 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 ratios=()
 for i in $(seq 1 "$pairs"); do
-  t_old=$(run "$old/build/benchmarks/$program" "$tmp/old.json")
-  t_new=$(run "${SEXTANT_BENCH_BUILD_DIR:-build-bench}/benchmarks/$program" "$tmp/new.json")
+  t_old=$(run "$old_build/benchmarks/$program" "$tmp/old.json")
+  t_new=$(run "$new_build/benchmarks/$program" "$tmp/new.json")
   ratio=$(python3 -c "import sys; print(f'{float(sys.argv[1].split()[0]) / float(sys.argv[2].split()[0]):.2f}')" "$t_old" "$t_new")
   echo "pair $i: $short ${t_old} s, this tree ${t_new} s, ratio ${ratio}x"
   ratios+=("$ratio")
