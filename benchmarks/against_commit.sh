@@ -28,26 +28,31 @@ jobs=$(nproc 2>/dev/null || echo 2)
 
 # A new build directory is configured as ./run.sh configures its own (a missing dependency stops it
 # instead of leaving a slower fallback in one of the two builds); an older tree without that option
-# ignores it.
-build() {  # build <source dir> <build dir>
+# ignores it. An existing one keeps its configuration.
+configure() {  # configure <source dir> <build dir>
   [ -f "$2/CMakeCache.txt" ] || cmake -S "$1" -B "$2" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER="$cxx" \
     -DSEXTANT_REQUIRE_ALL_DEPENDENCIES=ON -DSEXTANT_BUILD_BENCHMARKS=ON -DSEXTANT_BUILD_TESTS=OFF > /dev/null
-  cmake --build "$2" --target "$program" -j"$jobs" > "$2/against_commit_build.log" 2>&1 ||
-    { echo "against_commit: building $program in $2 failed: $2/against_commit_build.log" >&2; exit 1; }
+}
+build() {  # build <build dir>
+  cmake --build "$1" --target "$program" -j"$jobs" > "$1/against_commit_build.log" 2>&1 ||
+    { echo "against_commit: building $program in $1 failed: $1/against_commit_build.log" >&2; exit 1; }
 }
 if [ ! -d "$old/src" ]; then
   mkdir -p "$old/src"
   git archive "$commit" | tar -x -C "$old/src"
 fi
-echo "against_commit: building $program at $short and in this tree ($cxx)" >&2
-build "$old/src" "$old_build"
-build "$root" "$new_build"
+configure "$old/src" "$old_build"
+configure "$root" "$new_build"
+# Before either build: a ratio across compilers would measure the compilers.
 compiler_of() { sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$1/CMakeCache.txt"; }
 if [ "$(compiler_of "$old_build")" != "$(compiler_of "$new_build")" ]; then
   echo "against_commit: $new_build was configured with $(compiler_of "$new_build"), the older build with" \
     "$(compiler_of "$old_build"): a ratio across compilers measures the compilers (SEXTANT_BENCH_BUILD_DIR names another build)" >&2
   exit 1
 fi
+echo "against_commit: building $program at $short and in this tree ($cxx)" >&2
+build "$old_build"
+build "$new_build"
 
 core=$(( $(nproc 2>/dev/null || echo 1) - 1 ))
 run() {  # run <program path> <json out>: one pinned run; prints its real time in s
