@@ -64,7 +64,7 @@ run() {  # run <program path> <json out>: one pinned run; prints its real time i
   python3 -c 'import json,sys
 runs=[b for b in json.load(open(sys.argv[1]))["benchmarks"] if b.get("run_type","iteration")=="iteration"]
 scale={"s":1,"ms":1e-3,"us":1e-6,"ns":1e-9}
-print(" ".join("%.4f" % (b["real_time"] * scale[b["time_unit"]]) for b in runs))' "$2"
+print(" ".join("%.4g" % (b["real_time"] * scale[b["time_unit"]]) for b in runs))' "$2"
 }
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
