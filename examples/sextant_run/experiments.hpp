@@ -41,6 +41,12 @@ inline AssociationRow association_row(const eval::AssociationScore& a) {
   return {a.precision(), a.recall(), a.wrong(), a.duplicates(), a.discarded(), a.searches_cut()};
 }
 
+/// A run's final optimization as the table's row has it (one run); none for a filter.
+inline std::optional<OptimizationRow> optimization_row(const std::optional<eval::OptimizationOutcome>& outcome) {
+  if (!outcome) return std::nullopt;
+  return OptimizationRow{1, outcome->converged ? 0 : 1, outcome->iterations};
+}
+
 /// Whether `kind` sits this data set out because the ids are withheld and it cannot associate.
 inline bool left_out(BackendKind kind, const RunnerConfig& c, const std::string& dataset) {
   if (!c.association.method || associates(kind)) return false;
@@ -51,7 +57,7 @@ inline bool left_out(BackendKind kind, const RunnerConfig& c, const std::string&
 
 /// The row of a back-end that failed as a whole: its message instead of scores.
 inline TableRow failed_row(const std::string& dataset, const BackendChoice& choice, std::string why) {
-  TableRow row{dataset, choice.key, choice.label, {}, 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt};
+  TableRow row{dataset, choice.key, choice.label, {}, 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt};
   row.summary.mark_unscored();
   row.failure = std::move(why);
   return row;
@@ -130,10 +136,11 @@ std::vector<TableRow> run_on_rawlog(const std::string& name, const Dataset& data
       continue;
     }
     rows.push_back({name, choice.key, choice.label,
-                    eval::summarize(std::vector{result.run}, scoring.pose_dof, scoring.landmark_dof), 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt});
+                    eval::summarize(std::vector{result.run}, scoring.pose_dof, scoring.landmark_dof), 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt});
     if (const auto& a = result.association) rows.back().association = association_row(*a);
     rows.back().cloud = result.cloud;
     rows.back().relocalization = result.relocalization;
+    rows.back().optimization = optimization_row(result.run.optimization);
     if constexpr (requires { data.has_ground_truth(); })
       if (!data.has_ground_truth()) rows.back().summary.mark_unscored();
     first_runs.emplace_back(kind, std::move(result));
@@ -175,6 +182,10 @@ std::vector<eval::StudyRecord> ship_records(const std::vector<BackendKind>& kind
       }
       if (const auto& relocalization = result.relocalization) {
         const auto extras = relocalization_extras(*relocalization);
+        record.extras.insert(record.extras.end(), extras.begin(), extras.end());
+      }
+      if (const auto optimization = optimization_row(result.run.optimization)) {
+        const auto extras = optimization_extras(*optimization);
         record.extras.insert(record.extras.end(), extras.begin(), extras.end());
       }
       if (seed == c.ship.seed) {

@@ -33,6 +33,11 @@ std::vector<std::pair<std::string, double>> relocalization_extras(const Relocali
           {"stale_recoveries", r.stale_recoveries}};
 }
 
+std::vector<std::pair<std::string, double>> optimization_extras(const OptimizationRow& o) {
+  return {{"optimization_unconverged", static_cast<double>(o.unconverged)},
+          {"optimization_iterations", static_cast<double>(o.iterations)}};
+}
+
 namespace {
 
 bool has_extra(const eval::StudyRecord& r, const char* name) {
@@ -61,9 +66,22 @@ std::optional<AssociationRow> association_of(const eval::StudyRecord& r) {
                         has_extra(r, "association_searches_cut") ? static_cast<std::size_t>(r.extra("association_searches_cut")) : 0};
 }
 
+/// In how many of records[begin, end) the final optimization stopped unconverged; none for filters.
+std::optional<OptimizationRow> optimization_of(std::vector<eval::StudyRecord>::const_iterator begin,
+                                               std::vector<eval::StudyRecord>::const_iterator end) {
+  if (!has_extra(*begin, "optimization_unconverged")) return std::nullopt;
+  OptimizationRow row{static_cast<int>(end - begin), 0, 0};
+  for (auto r = begin; r != end; ++r) {
+    if (r->extra("optimization_unconverged") == 0.0) continue;
+    ++row.unconverged;
+    row.iterations = std::max(row.iterations, static_cast<int>(r->extra("optimization_iterations")));
+  }
+  return row;
+}
+
 /// The row of one cell's runs (records[begin, end), in seed order).
 TableRow row_of(std::vector<eval::StudyRecord>::const_iterator begin, std::vector<eval::StudyRecord>::const_iterator end) {
-  TableRow row{begin->dataset, begin->cell, begin->label, {}, static_cast<int>(end - begin), std::nullopt, std::nullopt, std::nullopt, std::nullopt};
+  TableRow row{begin->dataset, begin->cell, begin->label, {}, static_cast<int>(end - begin), std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt};
   std::vector<eval::RunScores> scores;
   for (auto r = begin; r != end; ++r) {
     if (!r->failure.empty() && !row.failure) row.failure = "seed " + std::to_string(r->seed) + ": " + r->failure;
@@ -77,6 +95,7 @@ TableRow row_of(std::vector<eval::StudyRecord>::const_iterator begin, std::vecto
   row.association = association_of(*begin);  // the first seed's
   row.cloud = cloud_of(*begin);
   row.relocalization = relocalization_of(*begin);
+  row.optimization = optimization_of(begin, end);
   return row;
 }
 

@@ -21,6 +21,9 @@ std::vector<std::pair<std::string, double>> cloud_extras(const CloudRow& cloud);
 /// An ESEIF run's relocalizations as a record's extras (read back by the table's row).
 std::vector<std::pair<std::string, double>> relocalization_extras(const RelocalizationRow& relocalization);
 
+/// A GraphSLAM run's final optimization as a record's extras (the table's row counts the unconverged).
+std::vector<std::pair<std::string, double>> optimization_extras(const OptimizationRow& optimization);
+
 /// --merge: prints the table of the study whose record files (or directories of them) are `paths`
 /// and returns its rows.
 std::vector<TableRow> merged_rows(const std::string& program, const std::vector<std::string>& paths);

@@ -274,7 +274,7 @@ TableRow table_row(const GlobeRun& r, std::size_t steps) {
   s.seconds_per_step = r.total_seconds / static_cast<double>(steps);
   s.failed_steps = r.failures.total();
   s.first_failure = r.failures.first;
-  TableRow row{"globe", r.key, r.label, s, 1, std::nullopt, std::nullopt, std::nullopt, r.relocalization};
+  TableRow row{"globe", r.key, r.label, s, 1, std::nullopt, std::nullopt, std::nullopt, r.relocalization, std::nullopt};
   if (r.failure) {
     row.summary.mark_unscored();
     row.failure = r.failure;

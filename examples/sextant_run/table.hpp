@@ -80,6 +80,16 @@ inline void print_relocalization(int indent, const RelocalizationRow& r) {
                 indent, "", r.stale_recoveries, r.steps);
 }
 
+/// The line below a GraphSLAM row whose final Gauss-Newton stopped at its iteration limit before
+/// converging in some run: its estimate is then not the optimum the row's scores are meant to show.
+inline void print_unconverged(int indent, const OptimizationRow& o) {
+  if (o.unconverged == 0) return;
+  const std::string in_runs =
+      o.runs > 1 ? " in " + std::to_string(o.unconverged) + " of " + std::to_string(o.runs) + " runs" : std::string();
+  std::printf("%-*s Gauss-Newton stopped at its limit of %d iteration%s before converging%s; [graph] max_iterations "
+              "raises it\n", indent, "", o.iterations, o.iterations == 1 ? "" : "s", in_runs.c_str());
+}
+
 /// The pose ANEES, or "collapsed" where some steps' covariance rests on too few particles to be one
 /// (eval::RunScores::pose_undersampled): a particle cloud's NEES there is 1e5-1e8, the sample's size.
 inline std::string anees_cell(const eval::Summary& s) {
@@ -108,6 +118,7 @@ inline void print_row(const TableRow& row) {
                 "its NEES there the sample's; the ANEES over the other steps: %s\n", "", 100.0 * s.pose_undersampled,
                 cell("%.4g", s.pose_anees_supported).c_str());
   if (const auto& r = row.relocalization) print_relocalization(29, *r);
+  if (const auto& o = row.optimization) print_unconverged(29, *o);
   print_skipped_steps(29, row.summary.failed_steps, "step", row.summary.first_failure);  // over all its runs
 }
 
@@ -162,6 +173,7 @@ inline void write_summary_json(const std::string& path, const std::vector<TableR
         out << ", \"relocalizations\": " << json_number(r->relocalizations) << ", \"active_at_end\": " << json_number(r->active);
       if (r->stale_recoveries >= 0.0) out << ", \"stale_recoveries\": " << json_number(r->stale_recoveries);
     }
+    if (const auto& o = rows[i].optimization) out << ", \"optimization_unconverged_runs\": " << o->unconverged;
     out << "}" << (i + 1 < rows.size() ? ",\n" : "\n");
   }
   out << "]\n";

@@ -70,6 +70,12 @@ struct RelocalizationRow {
   double stale_recoveries = -1.0;  ///< -1: stale_mean_probability off
 };
 
+/// Full SLAM's final Gauss-Newton over a row's runs: in how many it stopped at its iteration limit
+/// before converging (eval::OptimizationOutcome), and that limit.
+struct OptimizationRow {
+  int runs = 1, unconverged = 0, iterations = 0;
+};
+
 /// A line of the comparison table.
 struct TableRow {
   std::string dataset, backend, label;
@@ -79,6 +85,7 @@ struct TableRow {
   std::optional<std::string> failure;  ///< why the back-end gave no result: its row prints this instead
   std::optional<CloudRow> cloud;       ///< FastSLAM: the first run's cloud at its end
   std::optional<RelocalizationRow> relocalization;  ///< ESEIF: the first run's relocalizations
+  std::optional<OptimizationRow> optimization;      ///< GraphSLAM: its optimizations over the runs
 };
 
 }  // namespace sextant::runner

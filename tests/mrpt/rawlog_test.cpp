@@ -114,7 +114,16 @@ TEST(KfSlam6dDemos, EveryBackEndMapsTheSpatialDemo) {
   SeifSlam<Motion, Sensor> seif(data.motion, data.sensor, data.prior, {.max_active = 8});
   EXPECT_LT(eval::mean(eval::evaluate_run(seif, data, 3).map_error), 2.0 * ekf_error);
   GraphSlam<Motion, Sensor> graph(data.motion, data.sensor, data.prior);
-  EXPECT_LT(eval::mean(eval::evaluate_smoothed_run(graph, data, 3).map_error), 2.0 * ekf_error);
+  const auto graph_run = eval::evaluate_smoothed_run(graph, data, 3);
+  EXPECT_LT(eval::mean(graph_run.map_error), 2.0 * ekf_error);
+  ASSERT_TRUE(graph_run.optimization);  // the run records how its optimization ended
+  EXPECT_TRUE(graph_run.optimization->converged);
+  EXPECT_LE(graph_run.optimization->iterations, GraphOptions{}.max_iterations);
+  GraphSlam<Motion, Sensor> one_step(data.motion, data.sensor, data.prior, {.max_iterations = 1});
+  const auto one_step_run = eval::evaluate_smoothed_run(one_step, data, 3);  // from dead reckoning: not converged
+  ASSERT_TRUE(one_step_run.optimization);
+  EXPECT_FALSE(one_step_run.optimization->converged);
+  EXPECT_EQ(one_step_run.optimization->iterations, 1);
   FastSlam<Motion, Sensor> fast(data.motion, data.sensor, data.prior,
                                 {.particles = 100, .resample_threshold = 0.1, .map_estimate = FastSlamMap::weighted_average});
   const auto fast_run = eval::evaluate_run(fast, data, 3);

@@ -36,6 +36,14 @@ Result run_runner(const std::string& arguments, const fs::path& dir) {
   return run_program(std::string(SEXTANT_RUN_EXE) + " " + arguments, dir);
 }
 
+/// The whole of a file (summary.json, the docs); empty when it cannot be read.
+std::string text_of(const fs::path& path) {
+  std::ifstream file(path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
 class RunnerCli : public ::testing::Test {
  protected:
   fs::path dir = fs::temp_directory_path() / ("sextant_run_cli_" + std::to_string(::getpid()) + "_" +
@@ -341,10 +349,7 @@ TEST_F(RunnerCli, ConfigFilesThatAreNotSettingsAreRefused) {
 TEST_F(RunnerCli, ConfigReferenceInDocsIsThePrintedDefaults) {
   const auto r = run_runner("--print-config", dir);
   ASSERT_EQ(r.exit_code, 0);
-  std::ifstream docs(SEXTANT_RUNNER_DOCS);
-  std::stringstream text;
-  text << docs.rdbuf();
-  EXPECT_NE(text.str().find("```ini\n" + r.out + "```"), std::string::npos)
+  EXPECT_NE(text_of(SEXTANT_RUNNER_DOCS).find("```ini\n" + r.out + "```"), std::string::npos)
       << "docs/runner.md must hold the output of sextant-run --print-config in an ini block";
 }
 
@@ -396,11 +401,9 @@ TEST_F(RunnerCli, ACollapsedCloudSaysSoInsteadOfPrintingItsNees) {
   EXPECT_NE(one.find(" collapsed "), std::string::npos) << r.out;
   EXPECT_EQ(two.find("collapsed"), std::string::npos) << r.out;
   EXPECT_NE(note.find("of the steps the pose rests on fewer than dof + 1 effective particles"), std::string::npos) << r.out;
-  std::ifstream json(out / "summary.json");
-  std::stringstream text;
-  text << json.rdbuf();
-  EXPECT_NE(text.str().find("\"pose_undersampled\": 0.9"), std::string::npos) << text.str();  // most steps
-  EXPECT_NE(text.str().find("\"pose_undersampled\": 0,"), std::string::npos) << text.str();   // FastSLAM 2.0
+  const std::string json = text_of(out / "summary.json");
+  EXPECT_NE(json.find("\"pose_undersampled\": 0.9"), std::string::npos) << json;  // most steps
+  EXPECT_NE(json.find("\"pose_undersampled\": 0,"), std::string::npos) << json;   // FastSLAM 2.0
   EXPECT_NE(note.find("; the ANEES over the other steps: "), std::string::npos) << r.out;
 }
 
@@ -425,6 +428,24 @@ TEST_F(RunnerCli, EseifRunsBesideTheThesisSeifAndOnceWhenSeifRelocalizesToo) {
   ASSERT_EQ(once.exit_code, 0) << once.err;
   EXPECT_EQ(rows_labelled(once.out, "SEIF-SLAM, 8 active"), 0u) << once.out;
   EXPECT_EQ(rows_labelled(once.out, "ESEIF-SLAM, 8 active"), 1u) << once.out;
+}
+
+/// A GraphSLAM whose final Gauss-Newton stopped at its iteration limit says so below its row (its
+/// estimate is not the optimum); one that converged says nothing. One iteration from dead reckoning
+/// cannot converge: its step is the whole correction, far above the step tolerance.
+TEST_F(RunnerCli, GraphSlamStoppedBeforeConvergingSaysSo) {
+  const auto ini = (dir / "graph.ini").string();
+  std::ofstream(ini) << "[ship]\nruns = 2\nsteps = 60\n";
+  const auto converged = run_runner("-d ship -b graph -c " + ini, dir);
+  ASSERT_EQ(converged.exit_code, 0) << converged.err;
+  EXPECT_EQ(converged.out.find("Gauss-Newton stopped"), std::string::npos) << converged.out;
+  std::ofstream(ini, std::ios::app) << "[graph]\nmax_iterations = 1\n";
+  const auto stopped = run_runner("-d ship -b graph -c " + ini + " -o " + (dir / "stopped").string(), dir);
+  ASSERT_EQ(stopped.exit_code, 0) << stopped.err;
+  EXPECT_NE(stopped.out.find("Gauss-Newton stopped at its limit of 1 iteration before converging in 2 of 2 runs; "
+                             "[graph] max_iterations raises it"), std::string::npos) << stopped.out;
+  const std::string json = text_of(dir / "stopped" / "summary.json");
+  EXPECT_NE(json.find("\"optimization_unconverged_runs\": 2"), std::string::npos) << json;
 }
 
 TEST_F(RunnerCli, IniValuesReachTheBackEnds) {
@@ -476,10 +497,8 @@ TEST_F(RunnerCli, IsamTextWithoutGroundTruthIsTimedAndWrittenNotScored) {
   EXPECT_NE(r.out.find("no ground truth beside it"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("EKF-SLAM                               -          -"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::exists(out / "loop" / "graph_map.csv"));
-  std::ifstream json((out / "summary.json").string());
-  std::stringstream text;
-  text << json.rdbuf();
-  EXPECT_NE(text.str().find("\"pose_mae\": null"), std::string::npos) << text.str();
+  const std::string json = text_of(out / "summary.json");
+  EXPECT_NE(json.find("\"pose_mae\": null"), std::string::npos) << json;
 }
 
 /// A g2o file goes to sextant-pose-graph: its size, chi2 before and after, the optimized graph

@@ -262,7 +262,7 @@ TableRow table_row(const ViData& d, const ViRun& r) {
   s.seconds_per_step = r.seconds / static_cast<double>(d.frames.size());
   s.failed_steps = r.failures.total();
   s.first_failure = r.failures.first;
-  TableRow row{d.name, r.key, r.label, s, 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt};
+  TableRow row{d.name, r.key, r.label, s, 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt};
   row.failure = r.failure;
   return row;
 }

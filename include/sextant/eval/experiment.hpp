@@ -22,6 +22,13 @@ struct NoStepCallback {
   void operator()(std::size_t) const {}
 };
 
+/// Full SLAM's final optimization: the Gauss-Newton iterations it took and whether it converged
+/// (step or cost change below its tolerance) before its iteration limit.
+struct OptimizationOutcome {
+  int iterations = 0;
+  bool converged = true;
+};
+
 /// Accuracy, consistency and time of one run.
 template <class State>
 struct RunSummary {
@@ -41,6 +48,7 @@ struct RunSummary {
   double map_error_over_time = 0.0;
   double total_seconds = 0.0;
   StepFailures failures;  ///< steps skipped under StepErrors::skip (for_each_step)
+  std::optional<OptimizationOutcome> optimization;  ///< full SLAM whose optimize() reports one (GraphSlam)
 };
 
 namespace detail {
@@ -104,11 +112,17 @@ void run_timed_steps(Backend& backend, const Dataset& dataset, Summary& out, Aft
       failures_under(on_error, out.failures));
 }
 
-/// Full SLAM's optimize(), its time added to out.total_seconds.
+/// Full SLAM's optimize(), its time added to out.total_seconds and, where it reports them, its
+/// iterations and convergence to out.optimization.
 template <class Backend, class Summary>
 void optimize_timed(Backend& backend, Summary& out) {
   const auto start = std::chrono::steady_clock::now();
-  backend.optimize();
+  if constexpr (requires { backend.optimize().converged; }) {
+    const auto summary = backend.optimize();
+    out.optimization = OptimizationOutcome{summary.iterations, summary.converged};
+  } else {
+    backend.optimize();
+  }
   out.total_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 }  // namespace detail
