@@ -62,6 +62,7 @@ struct GlobeRun {
   eval::StepFailures failures;                    ///< steps that failed and were skipped
   std::optional<std::string> failure;             ///< why the back-end as a whole gave no result
   std::optional<RelocalizationRow> relocalization;  ///< ESEIF's relocalizations over the run
+  std::optional<OptimizationRow> optimization;      ///< GraphSLAM: how its last global update ended
 };
 
 /// The landmarks of `map` that have a true point (a rendered front-end may propose a landmark whose
@@ -129,7 +130,8 @@ GlobeRun run_graph(Graph& graph, const Dataset& data, const RunnerConfig& c, std
   out.step_seconds = std::move(run.seconds);
   for (int update = 0; update < c.globe.graph_updates; ++update) {
     const auto start = std::chrono::steady_clock::now();
-    graph.optimize();
+    const auto summary = graph.optimize();
+    out.optimization = OptimizationRow{1, summary.converged ? 0 : 1, summary.iterations};
     out.graph_update_seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     out.total_seconds += out.graph_update_seconds.back();
     // Means after each update (Table 10); the marginals once, after the last.
@@ -258,6 +260,7 @@ void print_globe_row(const GlobeRun& r, std::size_t steps) {
               share(s.map_nees_inside).c_str(), number(s.position_anees).c_str(), r.total_seconds,
               1e3 * r.total_seconds / static_cast<double>(steps));
   if (r.relocalization) print_relocalization(27, *r.relocalization);
+  if (r.optimization) print_unconverged(27, *r.optimization);
   print_skipped_steps(27, r.failures.total(), "step", r.failures.first);
 }
 
@@ -274,7 +277,7 @@ TableRow table_row(const GlobeRun& r, std::size_t steps) {
   s.seconds_per_step = r.total_seconds / static_cast<double>(steps);
   s.failed_steps = r.failures.total();
   s.first_failure = r.failures.first;
-  TableRow row{"globe", r.key, r.label, s, 1, std::nullopt, std::nullopt, std::nullopt, r.relocalization, std::nullopt};
+  TableRow row{"globe", r.key, r.label, s, 1, std::nullopt, std::nullopt, std::nullopt, r.relocalization, r.optimization};
   if (r.failure) {
     row.summary.mark_unscored();
     row.failure = r.failure;
