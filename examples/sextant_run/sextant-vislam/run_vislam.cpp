@@ -59,6 +59,7 @@ struct ViRun {
   double rmse = std::nan(""), anees = std::nan("");
   eval::StepFailures failures;         ///< frames whose predict or update failed and were skipped
   std::optional<std::string> failure;  ///< why the back-end as a whole gave no result
+  std::optional<OptimizationRow> optimization;  ///< GraphSLAM: how its optimization ended
 };
 
 ViData simulated(const RunnerConfig& c) {
@@ -155,6 +156,7 @@ ViRun run_graph(Graph& graph, const ViData& d, std::string key, std::string labe
   out.map.clear();
   for (const auto& [id, mean] : graph.landmark_means()) out.map.push_back({id, mean, Eigen::Matrix3d::Zero()});
   out.label += ", LM, " + std::to_string(summary.iterations) + " iterations";
+  out.optimization = OptimizationRow{1, summary.converged ? 0 : 1, summary.iterations};
   return out;
 }
 
@@ -243,6 +245,7 @@ void print_table(const ViData& d, const std::vector<ViRun>& runs) {
                 r.in_state, r.updates.initialized, r.updates.corrected, r.updates.rejected, r.updates.unusable, number_or_dash(r.rmse, "%.2f").c_str(),
                 number_or_dash(dead_reckoning_rmse / r.rmse, "%.2fx").c_str(), number_or_dash(r.anees, "%.2f").c_str(),
                 1e3 * r.seconds / static_cast<double>(d.frames.size()));
+    if (r.optimization) print_unconverged(38, *r.optimization);
     print_skipped_steps(38, r.failures.total(), "frame", r.failures.first);
   }
   std::printf("RMSE: position against %s; vs DR: dead reckoning's RMSE over this one (higher is better); in state: "
@@ -262,7 +265,7 @@ TableRow table_row(const ViData& d, const ViRun& r) {
   s.seconds_per_step = r.seconds / static_cast<double>(d.frames.size());
   s.failed_steps = r.failures.total();
   s.first_failure = r.failures.first;
-  TableRow row{d.name, r.key, r.label, s, 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt};
+  TableRow row{d.name, r.key, r.label, s, 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt, r.optimization};
   row.failure = r.failure;
   return row;
 }
