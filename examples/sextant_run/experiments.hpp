@@ -41,12 +41,6 @@ inline AssociationRow association_row(const eval::AssociationScore& a) {
   return {a.precision(), a.recall(), a.wrong(), a.duplicates(), a.discarded(), a.searches_cut()};
 }
 
-/// A run's final optimization as the table's row has it (one run); none for a filter.
-inline std::optional<OptimizationRow> optimization_row(const std::optional<eval::OptimizationOutcome>& outcome) {
-  if (!outcome) return std::nullopt;
-  return OptimizationRow{1, outcome->converged ? 0 : 1, outcome->iterations};
-}
-
 /// Whether `kind` sits this data set out because the ids are withheld and it cannot associate.
 inline bool left_out(BackendKind kind, const RunnerConfig& c, const std::string& dataset) {
   if (!c.association.method || associates(kind)) return false;
@@ -140,7 +134,7 @@ std::vector<TableRow> run_on_rawlog(const std::string& name, const Dataset& data
     if (const auto& a = result.association) rows.back().association = association_row(*a);
     rows.back().cloud = result.cloud;
     rows.back().relocalization = result.relocalization;
-    rows.back().optimization = optimization_row(result.run.optimization);
+    if (const auto& o = result.run.optimization) rows.back().optimization = optimization_row(*o);
     if constexpr (requires { data.has_ground_truth(); })
       if (!data.has_ground_truth()) rows.back().summary.mark_unscored();
     first_runs.emplace_back(kind, std::move(result));
@@ -184,8 +178,8 @@ std::vector<eval::StudyRecord> ship_records(const std::vector<BackendKind>& kind
         const auto extras = relocalization_extras(*relocalization);
         record.extras.insert(record.extras.end(), extras.begin(), extras.end());
       }
-      if (const auto optimization = optimization_row(result.run.optimization)) {
-        const auto extras = optimization_extras(*optimization);
+      if (const auto& optimization = result.run.optimization) {
+        const auto extras = optimization_extras(optimization_row(*optimization));
         record.extras.insert(record.extras.end(), extras.begin(), extras.end());
       }
       if (seed == c.ship.seed) {

@@ -131,7 +131,7 @@ GlobeRun run_graph(Graph& graph, const Dataset& data, const RunnerConfig& c, std
   for (int update = 0; update < c.globe.graph_updates; ++update) {
     const auto start = std::chrono::steady_clock::now();
     const auto summary = graph.optimize();
-    out.optimization = OptimizationRow{1, summary.converged ? 0 : 1, summary.iterations};
+    out.optimization = optimization_row(summary);
     out.graph_update_seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     out.total_seconds += out.graph_update_seconds.back();
     // Means after each update (Table 10); the marginals once, after the last.

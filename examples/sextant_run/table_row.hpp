@@ -76,6 +76,13 @@ struct OptimizationRow {
   int runs = 1, unconverged = 0, iterations = 0;
 };
 
+/// One run's optimization as its row: `summary` has iterations and converged (GraphSlam's
+/// OptimizationSummary, eval::OptimizationOutcome).
+template <class Summary>
+OptimizationRow optimization_row(const Summary& summary) {
+  return OptimizationRow{1, summary.converged ? 0 : 1, summary.iterations};
+}
+
 /// A line of the comparison table.
 struct TableRow {
   std::string dataset, backend, label;

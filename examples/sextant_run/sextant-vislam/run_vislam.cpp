@@ -156,7 +156,7 @@ ViRun run_graph(Graph& graph, const ViData& d, std::string key, std::string labe
   out.map.clear();
   for (const auto& [id, mean] : graph.landmark_means()) out.map.push_back({id, mean, Eigen::Matrix3d::Zero()});
   out.label += ", LM, " + std::to_string(summary.iterations) + " iterations";
-  out.optimization = OptimizationRow{1, summary.converged ? 0 : 1, summary.iterations};
+  out.optimization = optimization_row(summary);
   return out;
 }
 
