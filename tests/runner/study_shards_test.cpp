@@ -82,6 +82,23 @@ TEST_F(StudyShards, ThreeShardsMergedPrintTheTableOfOneProcess) {
   EXPECT_EQ(rows_with_times(again.out), rows_with_times(whole.out));
 }
 
+/// What the table says below a row travels through the records: a GraphSLAM that stopped at its
+/// iteration limit in every run says so, counted over the merged shards' runs.
+TEST_F(StudyShards, UnconvergedOptimizationsAreCountedOverTheMergedShards) {
+  std::ofstream(dir / "one_iteration.ini") << "[ship]\nsteps = 60\n[graph]\nmax_iterations = 1\n";
+  const std::string study = "--dataset ship --runs 4 --backend graph -c " + (dir / "one_iteration.ini").string();
+  std::string shard_dirs;
+  for (int i = 0; i < 2; ++i) {
+    const auto shard_dir = dir / ("shard" + std::to_string(i));
+    ASSERT_EQ(run(study + " --shard " + std::to_string(i) + "/2 --out " + shard_dir.string()).exit_code, 0);
+    shard_dirs += " " + shard_dir.string();
+  }
+  const auto merged = run("--merge" + shard_dirs);
+  ASSERT_EQ(merged.exit_code, 0) << merged.err;
+  EXPECT_NE(merged.out.find("Gauss-Newton stopped at its limit of 1 iteration before converging in 4 of 4 runs"),
+            std::string::npos) << merged.out;
+}
+
 TEST_F(StudyShards, AMissingOrCorruptShardFileIsAnErrorNamingTheFileAndSeeds) {
   for (int i : {0, 2}) {
     const auto r = run(kStudy + " --shard " + std::to_string(i) + "/3 --out " + dir.string());
