@@ -1,7 +1,8 @@
 #pragma once
 /// \file The one block-sparse assembly: dense blocks written into a sparse matrix at (row, col),
 /// entries that meet summed (Eigen's setFromTriplets), in the order the blocks were added. GraphSLAM's
-/// normal equations and reduced system and SEIF's information matrix are assembled with it.
+/// normal equations, SEIF's information matrix and (through core/block_sum.hpp, which sums its
+/// blocks first) GraphSLAM's reduced system are assembled with it.
 
 #include <Eigen/SparseCore>
 #include <vector>
@@ -22,6 +23,7 @@ class BlockTriplets {
     add(row, col, block);
     add(col, row, block.transpose());
   }
+  void reserve(std::size_t entries) { triplets_.reserve(entries); }
   Eigen::SparseMatrix<double> to_sparse(Eigen::Index rows, Eigen::Index cols) const {
     Eigen::SparseMatrix<double> out(rows, cols);
     out.setFromTriplets(triplets_.begin(), triplets_.end());

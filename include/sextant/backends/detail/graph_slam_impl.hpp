@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "sextant/core/landmark_init.hpp"
+#include "sextant/core/block_sum.hpp"
 #include "sextant/core/block_triplets.hpp"
 #include "sextant/core/factor_information.hpp"
 #include "sextant/core/linearized_observation.hpp"
@@ -359,9 +360,9 @@ Eigen::VectorXd GraphSlam<Motion, Sensor>::solve_by_landmark_schur(const Lineari
                                                                     OptimizationSummary& summary) const {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  BlockTriplets triplets;  // S, pose blocks (a, b) at (X a, X b)
-  for (std::size_t p = 0; p < sys.pose_count; ++p) triplets.add(X * p, X * p, sys.pose_diagonal[p]);
-  for (const auto& link : sys.pose_links) triplets.add_symmetric(X * link.a, X * link.b, link.block);
+  BlockSum<X> reduced;  // S, pose blocks (a, b)
+  for (std::size_t p = 0; p < sys.pose_count; ++p) reduced.add(p, p, sys.pose_diagonal[p]);
+  for (const auto& link : sys.pose_links) reduced.add_symmetric(link.a, link.b, link.block);
   Eigen::VectorXd b = sys.pose_rhs;
   std::vector<Eigen::LLT<Eigen::Matrix<double, M, M>>> factors;
   factors.reserve(sys.landmarks.size());
@@ -375,10 +376,10 @@ Eigen::VectorXd GraphSlam<Motion, Sensor>::solve_by_landmark_schur(const Lineari
       const auto& [p, block] = terms.poses[a];
       b.template segment<X>(X * p) -= block * solved_rhs;
       for (std::size_t c = 0; c < terms.poses.size(); ++c)
-        triplets.add(X * p, X * terms.poses[c].first, Eigen::Matrix<double, X, X>(-(block * solved[c])));
+        reduced.add(p, terms.poses[c].first, Eigen::Matrix<double, X, X>(-(block * solved[c])));
     }
   }
-  const Eigen::SparseMatrix<double> S = triplets.to_sparse(X * sys.pose_count, X * sys.pose_count);
+  const Eigen::SparseMatrix<double> S = reduced.to_sparse(X * sys.pose_count, X * sys.pose_count);
   const auto eliminated = Clock::now();
   summary.seconds_eliminate += std::chrono::duration<double>(eliminated - start).count();
 

@@ -1,0 +1,63 @@
+#pragma once
+/// \file Fixed-size blocks summed where they meet on a block grid before they become triplets. A
+/// landmark seen from k poses adds k^2 blocks to GraphSLAM's reduced system (thesis eq. 68); as
+/// triplets that is 36 k^2 entries of 16 bytes each (1-2 GB on a visual-inertial log of 1105 frames),
+/// whose allocation and first touch cost more than the factorization. Summed here, each block of the
+/// grid is one dense block, written once into BlockTriplets.
+///
+/// Each block's contributions are summed in the order they were added, which is the order
+/// setFromTriplets sums duplicate entries in: the matrix is the one BlockTriplets builds from every
+/// contribution, bit for bit.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "sextant/core/block_triplets.hpp"
+
+namespace sextant {
+
+template <int Rows, int Cols = Rows>
+class BlockSum {
+ public:
+  using Block = Eigen::Matrix<double, Rows, Cols>;
+
+  /// Adds `block` at block row i, block column j (matrix rows [Rows i, Rows i + Rows)).
+  template <class Other>
+  void add(std::size_t i, std::size_t j, const Other& block) {
+    const auto [at, inserted] = index_.try_emplace(key(i, j), blocks_.size());
+    if (inserted)
+      blocks_.push_back({i, j, block});
+    else
+      blocks_[at->second].sum += block;
+  }
+  /// block at (i, j) and its transpose at (j, i): an off-diagonal block of a symmetric matrix.
+  template <class Other>
+  void add_symmetric(std::size_t i, std::size_t j, const Other& block) {
+    add(i, j, block);
+    add(j, i, block.transpose());
+  }
+
+  std::size_t blocks() const { return blocks_.size(); }
+
+  Eigen::SparseMatrix<double> to_sparse(Eigen::Index rows, Eigen::Index cols) const {
+    BlockTriplets triplets;
+    triplets.reserve(blocks_.size() * Rows * Cols);
+    for (const auto& b : blocks_)
+      triplets.add(Rows * static_cast<Eigen::Index>(b.i), Cols * static_cast<Eigen::Index>(b.j), b.sum);
+    return triplets.to_sparse(rows, cols);
+  }
+
+ private:
+  struct Entry {
+    std::size_t i, j;
+    Block sum;
+  };
+  static std::uint64_t key(std::size_t i, std::size_t j) { return (static_cast<std::uint64_t>(i) << 32) | j; }
+
+  std::unordered_map<std::uint64_t, std::size_t> index_;  ///< (i, j) -> its entry in blocks_
+  std::vector<Entry> blocks_;                               ///< in the order first added
+};
+
+}  // namespace sextant
