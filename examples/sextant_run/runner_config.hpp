@@ -717,7 +717,7 @@ inline std::vector<ConfigKey> graph_keys() {
      }},
     {"graph", "kernel_width", "2.4477", "robust kernel width, standard deviations of the whitened residual",
      [](RunnerConfig& c, const std::string& v) { c.graph.measurement_loss.width = positive(parse_number(v), v); }},
-    {"graph", "max_iterations", "10", "Gauss-Newton iterations at most",
+    {"graph", "max_iterations", "100", "Gauss-Newton iterations at most (it stops earlier once converged)",
      [](RunnerConfig& c, const std::string& v) { c.graph.max_iterations = parse_integer<int>(v, 1, 1e6); }},
     {"graph", "solver", "automatic", "automatic | landmark_schur (thesis) | full (sparse Cholesky of everything)",
      [](RunnerConfig& c, const std::string& v) {

@@ -178,7 +178,6 @@ std::vector<BackendChoice> vislam_choices(const std::vector<BackendKind>& kinds,
     choice.ekf.gate_probability = choice.seif.gate_probability = choice.fastslam.gate_probability =
         c.vislam.gate_probability;
     choice.graph.levenberg_marquardt = true;
-    choice.graph.max_iterations = std::max(choice.graph.max_iterations, 30);
     if (c.vislam.gate_probability > 0.0)
       choice.graph.measurement_loss = {RobustKernel::huber, std::sqrt(chi_square_quantile(4, c.vislam.gate_probability))};
     choices.push_back(choice);
@@ -265,7 +264,7 @@ TableRow table_row(const ViData& d, const ViRun& r) {
   s.seconds_per_step = r.seconds / static_cast<double>(d.frames.size());
   s.failed_steps = r.failures.total();
   s.first_failure = r.failures.first;
-  TableRow row{d.name, r.key, r.label, s, 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt, r.optimization};
+  TableRow row{.dataset = d.name, .backend = r.key, .label = r.label, .summary = s, .optimization = r.optimization};
   row.failure = r.failure;
   return row;
 }
