@@ -51,7 +51,7 @@ inline bool left_out(BackendKind kind, const RunnerConfig& c, const std::string&
 
 /// The row of a back-end that failed as a whole: its message instead of scores.
 inline TableRow failed_row(const std::string& dataset, const BackendChoice& choice, std::string why) {
-  TableRow row{dataset, choice.key, choice.label, {}, 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt};
+  TableRow row{.dataset = dataset, .backend = choice.key, .label = choice.label};
   row.summary.mark_unscored();
   row.failure = std::move(why);
   return row;
@@ -129,8 +129,8 @@ std::vector<TableRow> run_on_rawlog(const std::string& name, const Dataset& data
       rows.push_back(failed_row(name, choice, std::move(*why)));  // its row says so; the others still run
       continue;
     }
-    rows.push_back({name, choice.key, choice.label,
-                    eval::summarize(std::vector{result.run}, scoring.pose_dof, scoring.landmark_dof), 1, std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt});
+    rows.push_back({.dataset = name, .backend = choice.key, .label = choice.label,
+                    .summary = eval::summarize(std::vector{result.run}, scoring.pose_dof, scoring.landmark_dof)});
     if (const auto& a = result.association) rows.back().association = association_row(*a);
     rows.back().cloud = result.cloud;
     rows.back().relocalization = result.relocalization;

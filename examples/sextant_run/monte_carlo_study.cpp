@@ -81,7 +81,7 @@ std::optional<OptimizationRow> optimization_of(std::vector<eval::StudyRecord>::c
 
 /// The row of one cell's runs (records[begin, end), in seed order).
 TableRow row_of(std::vector<eval::StudyRecord>::const_iterator begin, std::vector<eval::StudyRecord>::const_iterator end) {
-  TableRow row{begin->dataset, begin->cell, begin->label, {}, static_cast<int>(end - begin), std::nullopt, std::nullopt, std::nullopt, std::nullopt, std::nullopt};
+  TableRow row{.dataset = begin->dataset, .backend = begin->cell, .label = begin->label, .runs = static_cast<int>(end - begin)};
   std::vector<eval::RunScores> scores;
   for (auto r = begin; r != end; ++r) {
     if (!r->failure.empty() && !row.failure) row.failure = "seed " + std::to_string(r->seed) + ": " + r->failure;

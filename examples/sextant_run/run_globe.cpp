@@ -277,7 +277,8 @@ TableRow table_row(const GlobeRun& r, std::size_t steps) {
   s.seconds_per_step = r.total_seconds / static_cast<double>(steps);
   s.failed_steps = r.failures.total();
   s.first_failure = r.failures.first;
-  TableRow row{"globe", r.key, r.label, s, 1, std::nullopt, std::nullopt, std::nullopt, r.relocalization, r.optimization};
+  TableRow row{.dataset = "globe", .backend = r.key, .label = r.label, .summary = s, .relocalization = r.relocalization,
+               .optimization = r.optimization};
   if (r.failure) {
     row.summary.mark_unscored();
     row.failure = r.failure;

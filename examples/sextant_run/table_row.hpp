@@ -83,16 +83,17 @@ OptimizationRow optimization_row(const Summary& summary) {
   return OptimizationRow{1, summary.converged ? 0 : 1, summary.iterations};
 }
 
-/// A line of the comparison table.
+/// A line of the comparison table. Every member has an initializer, so that a row is written with
+/// designated initializers naming only what it has.
 struct TableRow {
-  std::string dataset, backend, label;
-  eval::Summary summary;
+  std::string dataset{}, backend{}, label{};
+  eval::Summary summary{};
   int runs = 1;
-  std::optional<AssociationRow> association;
-  std::optional<std::string> failure;  ///< why the back-end gave no result: its row prints this instead
-  std::optional<CloudRow> cloud;       ///< FastSLAM: the first run's cloud at its end
-  std::optional<RelocalizationRow> relocalization;  ///< ESEIF: the first run's relocalizations
-  std::optional<OptimizationRow> optimization;      ///< GraphSLAM: its optimizations over the runs
+  std::optional<AssociationRow> association{};
+  std::optional<std::string> failure{};  ///< why the back-end gave no result: its row prints this instead
+  std::optional<CloudRow> cloud{};       ///< FastSLAM: the first run's cloud at its end
+  std::optional<RelocalizationRow> relocalization{};  ///< ESEIF: the first run's relocalizations
+  std::optional<OptimizationRow> optimization{};      ///< GraphSLAM: its optimizations over the runs
 };
 
 }  // namespace sextant::runner
