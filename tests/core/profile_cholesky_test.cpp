@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <limits>
 #include <random>
 
 namespace sextant {
@@ -19,6 +20,17 @@ Block random_block(std::mt19937& rng) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) b(i, j) = u(rng);
   return b;
+}
+
+/// Rows 0 .. rows - 1 of a block-tridiagonal matrix (a chain of poses), staged, not factorized.
+Profile chain(std::size_t rows, double diagonal, std::mt19937& rng) {
+  Profile S;
+  for (std::size_t n = 0; n < rows; ++n) {
+    S.append_row();
+    S.add(n, n, diagonal * Block::Identity());
+    if (n > 0) S.add(n, n - 1, random_block(rng));
+  }
+  return S;
 }
 
 /// Grows a block matrix row by row as an online smoother does (each new row couples to the last
@@ -59,12 +71,7 @@ TEST(ProfileCholesky, IncrementalFactorEqualsTheDenseOneAndRefactorizesOnlyFromT
 /// were: the next solve is bit for bit the one before.
 TEST(ProfileCholesky, AnIndefiniteChangeThrowsAndLeavesMatrixAndFactorAsTheyWere) {
   std::mt19937 rng(5);
-  Profile S;
-  for (std::size_t n = 0; n < 10; ++n) {
-    S.append_row();
-    S.add(n, n, 4.0 * Block::Identity());
-    if (n > 0) S.add(n, n - 1, random_block(rng));
-  }
+  Profile S = chain(10, 4.0, rng);
   S.factorize();
   S.commit();
   const Eigen::VectorXd b = Eigen::VectorXd::Ones(30);
@@ -83,6 +90,36 @@ TEST(ProfileCholesky, AnIndefiniteChangeThrowsAndLeavesMatrixAndFactorAsTheyWere
   S.discard();
   EXPECT_EQ(S.solve(b), before);
   EXPECT_THROW(S.add(3, 4, Block::Identity()), invalid_input_error);  // not in the lower triangle
+}
+
+/// factorize() works in memory it keeps between calls; what is left there from an earlier, larger
+/// factorization (a loop closure) must not reach a later one: the original and a copy (whose memory
+/// starts empty) factorize the same change to the same bits, and a NaN in the change is refused.
+TEST(ProfileCholesky, MemoryKeptBetweenFactorizationsIsNotPartOfTheResult) {
+  std::mt19937 rng(7);
+  Profile S = chain(12, 10.0, rng);
+  S.add(11, 0, random_block(rng));  // reaches back to row 0: the whole matrix is the trailing block
+  S.factorize();
+  S.commit();
+  Profile copy = S;
+  for (Profile* P : {&S, &copy}) {
+    std::mt19937 same(9);
+    P->append_row();
+    P->add(12, 12, 10.0 * Block::Identity());
+    P->add(12, 11, random_block(same));
+    P->add(12, 10, random_block(same));
+    P->factorize();
+  }
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(39, -1.0, 2.0);
+  EXPECT_EQ(S.solve(b), copy.solve(b));
+  EXPECT_EQ(S.last_inverse_block(), copy.last_inverse_block());
+  S.commit();
+  const Eigen::VectorXd before = S.solve(b);
+  Block nan = Block::Zero();
+  nan(1, 0) = std::numeric_limits<double>::quiet_NaN();
+  S.add(12, 12, nan);
+  EXPECT_THROW(S.factorize(), numerical_error);
+  EXPECT_EQ(S.solve(b), before);
 }
 
 }  // namespace

@@ -29,6 +29,26 @@
 
 namespace sextant {
 
+/// Memory for a dense matrix that a computation reuses from one call to the next; it grows, never
+/// shrinks, and is not part of its owner's value (a copy starts empty).
+class ScratchMatrix {
+ public:
+  ScratchMatrix() = default;
+  ScratchMatrix(const ScratchMatrix&) {}
+  ScratchMatrix& operator=(const ScratchMatrix&) { return *this; }
+  ScratchMatrix(ScratchMatrix&&) noexcept = default;
+  ScratchMatrix& operator=(ScratchMatrix&&) noexcept = default;
+
+  /// A rows x cols view of the memory (contents unspecified).
+  Eigen::Map<Eigen::MatrixXd> matrix(Eigen::Index rows, Eigen::Index cols) {
+    if (static_cast<std::size_t>(rows * cols) > memory_.size()) memory_.resize(static_cast<std::size_t>(rows * cols));
+    return {memory_.data(), rows, cols};
+  }
+
+ private:
+  std::vector<double> memory_;
+};
+
 template <int B>
 class ProfileCholesky {
  public:
@@ -173,42 +193,57 @@ class ProfileCholesky {
     return staged_index_[i] < 0 ? matrix_[i] : staged_rows_[static_cast<std::size_t>(staged_index_[i])];
   }
 
-  /// The factor's rows e .. n - 1 of the staged matrix: chol(S[e:, e:] - L[e:, :e] L[e:, :e]^T).
-  std::vector<Row> factorized_trailing_rows() const {
+  /// The factor's rows e .. n - 1 of the staged matrix: chol(S[e:, e:] - L[e:, :e] L[e:, :e]^T),
+  /// factorized in place in memory kept from one call to the next (a dense block allocated, zeroed
+  /// and copied afresh each frame cost more than its factorization on a host slow to hand out pages).
+  std::vector<Row> factorized_trailing_rows() {
     const std::size_t e = first_changed_, n = staged_count_;
     std::size_t reach = e;  // the oldest column a trailing row of the factor keeps below e
     for (std::size_t i = e; i < n; ++i) reach = std::min(reach, matrix_row(i).first);
     const Eigen::Index m = B * static_cast<Eigen::Index>(n - e), below = B * static_cast<Eigen::Index>(e - reach);
-    Eigen::MatrixXd T = Eigen::MatrixXd::Zero(m, m), kept = Eigen::MatrixXd::Zero(m, below);
-    for (std::size_t i = e; i < n; ++i) {
-      const Row& row = matrix_row(i);
-      const Eigen::Index at = B * static_cast<Eigen::Index>(i - e);
-      const std::size_t from = std::max(row.first, e);
-      T.block(at, B * static_cast<Eigen::Index>(from - e), B, B * static_cast<Eigen::Index>(i + 1 - from)) =
-          row.blocks.rightCols(B * static_cast<Eigen::Index>(i + 1 - from));
-      if (row.first < e) {
-        const Eigen::Index width = B * static_cast<Eigen::Index>(e - row.first);
-        kept.block(at, below - width, B, width) = factor_[i].blocks.leftCols(width);  // unchanged part of L
-      }
-    }
-    if (below > 0) T.selfadjointView<Eigen::Lower>().rankUpdate(kept, -1.0);
-    if (!T.allFinite()) throw numerical_error("information matrix has NaN or Inf entries (incremental Cholesky)");
-    const Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> llt(T);
+    auto T = trailing_.matrix(m, m);
+    auto kept = kept_.matrix(m, below);
+    for (std::size_t i = e; i < n; ++i) write_trailing_row(i, T, kept);
+    if (below > 0) T.template selfadjointView<Eigen::Lower>().rankUpdate(kept, -1.0);
+    for (Eigen::Index at = 0; at < m; at += B)  // the lower triangle, the part written and factorized
+      if (!T.block(at, 0, B, at + B).allFinite()) throw numerical_error("information matrix has NaN or Inf entries (incremental Cholesky)");
+    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Lower> llt(T);
     if (llt.info() != Eigen::Success)
       throw numerical_error("information matrix is not positive definite (incremental Cholesky from block row " + std::to_string(e) + ")");
-    const Eigen::MatrixXd L = llt.matrixL();
     std::vector<Row> out;
     out.reserve(n - e);
-    for (std::size_t i = e; i < n; ++i) {
-      const Row& row = matrix_row(i);
-      Row r{row.first, Eigen::Matrix<double, B, Eigen::Dynamic>(B, row.blocks.cols())};
-      const std::size_t from = std::max(row.first, e);
-      const Eigen::Index at = B * static_cast<Eigen::Index>(i - e), tail = B * static_cast<Eigen::Index>(i + 1 - from);
-      r.blocks.rightCols(tail) = L.block(at, B * static_cast<Eigen::Index>(from - e), B, tail);
-      if (row.first < e) r.blocks.leftCols(r.blocks.cols() - tail) = factor_[i].blocks.leftCols(r.blocks.cols() - tail);
-      out.push_back(std::move(r));
-    }
+    for (std::size_t i = e; i < n; ++i) out.push_back(factor_row_from(i, T));
     return out;
+  }
+
+  /// Block row i of the trailing block T's lower triangle (S_i from column e on, zero left of its
+  /// envelope) and of `kept` (the committed factor's last kept.cols() columns before e, unchanged).
+  void write_trailing_row(std::size_t i, Eigen::Ref<Eigen::MatrixXd> T, Eigen::Ref<Eigen::MatrixXd> kept) const {
+    const std::size_t e = first_changed_;
+    const Row& row = matrix_row(i);
+    const Eigen::Index at = B * static_cast<Eigen::Index>(i - e);
+    const std::size_t from = std::max(row.first, e);
+    T.block(at, 0, B, B * static_cast<Eigen::Index>(from - e)).setZero();
+    T.block(at, B * static_cast<Eigen::Index>(from - e), B, B * static_cast<Eigen::Index>(i + 1 - from)) =
+        row.blocks.rightCols(B * static_cast<Eigen::Index>(i + 1 - from));
+    if (kept.cols() == 0) return;
+    const Eigen::Index width = row.first < e ? B * static_cast<Eigen::Index>(e - row.first) : 0;
+    kept.block(at, 0, B, kept.cols() - width).setZero();
+    if (width > 0) kept.block(at, kept.cols() - width, B, width) = factor_[i].blocks.leftCols(width);
+  }
+
+  /// Factor row i (i >= e): the unchanged columns before e, then row i - e of the trailing factor
+  /// (lower triangle of T, the diagonal block's upper part zero).
+  Row factor_row_from(std::size_t i, const Eigen::Ref<const Eigen::MatrixXd>& T) const {
+    const std::size_t e = first_changed_;
+    const Row& row = matrix_row(i);
+    Row r{row.first, Eigen::Matrix<double, B, Eigen::Dynamic>(B, row.blocks.cols())};
+    const std::size_t from = std::max(row.first, e);
+    const Eigen::Index at = B * static_cast<Eigen::Index>(i - e), tail = B * static_cast<Eigen::Index>(i + 1 - from);
+    r.blocks.rightCols(tail) = T.block(at, B * static_cast<Eigen::Index>(from - e), B, tail);
+    r.blocks.template rightCols<B>().template triangularView<Eigen::StrictlyUpper>().setZero();
+    if (row.first < e) r.blocks.leftCols(r.blocks.cols() - tail) = factor_[i].blocks.leftCols(r.blocks.cols() - tail);
+    return r;
   }
 
   std::vector<Row> matrix_;  ///< S, committed
@@ -217,6 +252,7 @@ class ProfileCholesky {
   std::vector<Row> staged_rows_;    ///< copies of the rows the staged changes touch, and new rows
   std::vector<std::size_t> staged_ids_;  ///< the row of each staged copy
   std::vector<Row> staged_factor_;  ///< rows first_changed_ .. of the staged matrix's factor
+  ScratchMatrix trailing_, kept_;   ///< factorize()'s dense blocks, kept between calls (not part of the value)
   bool factorized_ = false;
   std::size_t staged_count_ = 0;
   std::size_t first_changed_ = 0;
