@@ -80,13 +80,14 @@ inline void print_relocalization(int indent, const RelocalizationRow& r) {
                 indent, "", r.stale_recoveries, r.steps);
 }
 
-/// The line below a GraphSLAM row whose final Gauss-Newton stopped at its iteration limit before
-/// converging in some run: its estimate is then not the optimum the row's scores are meant to show.
+/// The line below a GraphSLAM row whose final optimization (Gauss-Newton or Levenberg-Marquardt)
+/// stopped at its iteration limit before converging in some run: its estimate is then not the
+/// optimum the row's scores are meant to show.
 inline void print_unconverged(int indent, const OptimizationRow& o) {
   if (o.unconverged == 0) return;
   const std::string in_runs =
       o.runs > 1 ? " in " + std::to_string(o.unconverged) + " of " + std::to_string(o.runs) + " runs" : std::string();
-  std::printf("%-*s Gauss-Newton stopped at its limit of %d iteration%s before converging%s; [graph] max_iterations "
+  std::printf("%-*s optimization stopped at its limit of %d iteration%s before converging%s; [graph] max_iterations "
               "raises it\n", indent, "", o.iterations, o.iterations == 1 ? "" : "s", in_runs.c_str());
 }
 
