@@ -52,7 +52,7 @@ TEST(DenseCholesky, FactorReproducesTheMatrixAndLeavesTheStrictUpperTriangleAlon
 TEST(DenseCholesky, FactorizesAViewWithAnOuterStrideInPlace) {
   const Eigen::Index n = 2 * kLapackMinDimension;
   const Eigen::MatrixXd a = random_spd(n, 11);
-  Eigen::MatrixXd big = Eigen::MatrixXd::Constant(n + 37, n + 37, -3.0);  // as SquareWorkspace's views
+  Eigen::MatrixXd big = Eigen::MatrixXd::Constant(n + 37, n + 37, -3.0);  // as MatrixWorkspace's views
   big.topLeftCorner(n, n) = a;
   ASSERT_TRUE(factorize_lower_in_place(big.topLeftCorner(n, n)));
   const Eigen::MatrixXd L = big.topLeftCorner(n, n).triangularView<Eigen::Lower>();

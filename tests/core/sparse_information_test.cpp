@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "sextant/core/square_workspace.hpp"
+#include "sextant/core/matrix_workspace.hpp"
 
 namespace sextant {
 namespace {
@@ -172,8 +172,8 @@ TEST(SparseInformation, CopiesAndMovesKeepTheLinksWhoeverOwnedTheirMemory) {
   EXPECT_EQ(Eigen::MatrixXd(replaced.to_sparse()), expected);
 }
 
-TEST(SquareWorkspace, HandsOutViewsOfOneBufferAndCopiesEmpty) {
-  SquareWorkspace workspace;
+TEST(MatrixWorkspace, HandsOutViewsOfOneBufferAndCopiesEmpty) {
+  MatrixWorkspace workspace;
   auto small = workspace.view(10);
   EXPECT_EQ(small.rows(), 10);
   EXPECT_EQ(small.cols(), 10);
@@ -183,14 +183,14 @@ TEST(SquareWorkspace, HandsOutViewsOfOneBufferAndCopiesEmpty) {
   EXPECT_EQ(workspace.memory_bytes(), bytes);  // no reallocation for a smaller block
   workspace.view(11);
   EXPECT_EQ(workspace.memory_bytes(), 12 * 12 * sizeof(double));  // grows by a quarter at least
-  const SquareWorkspace copy = workspace;
+  const MatrixWorkspace copy = workspace;
   EXPECT_EQ(copy.memory_bytes(), 0u);  // scratch is not state
   // From 2 MB on: whole huge pages, aligned to one, the column stride the capacity.
   const auto large = workspace.view(600);
   EXPECT_EQ(workspace.memory_bytes(), 2 * HugePageMemory::kHugePage);  // 600^2 doubles = 2.9 MB
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(large.data()) % HugePageMemory::kHugePage, 0u);
   EXPECT_EQ(large.outerStride(), 600);
-  SquareWorkspace moved = std::move(workspace);  // the buffer and its capacity go together
+  MatrixWorkspace moved = std::move(workspace);  // the buffer and its capacity go together
   EXPECT_EQ(moved.memory_bytes(), 2 * HugePageMemory::kHugePage);
   EXPECT_EQ(workspace.memory_bytes(), 0u);
   EXPECT_EQ(workspace.view(20).outerStride(), 20);  // a moved-from workspace allocates afresh
@@ -199,6 +199,16 @@ TEST(SquareWorkspace, HandsOutViewsOfOneBufferAndCopiesEmpty) {
   EXPECT_EQ(moved.view(20).outerStride(), 20);
   EXPECT_EQ(workspace.view(30).outerStride(), 30);
   workspace.view(30).setZero();
+  MatrixWorkspace wide;  // rectangular views: each dimension's capacity grows on its own
+  EXPECT_EQ(wide.view(6, 0).cols(), 0);
+  EXPECT_EQ(wide.memory_bytes(), 0u);  // an empty view allocates nothing
+  EXPECT_EQ(wide.view(40, 3).outerStride(), 40);
+  EXPECT_EQ(wide.memory_bytes(), 40 * 3 * sizeof(double));
+  const auto wider = wide.view(10, 8);  // fewer rows, more columns: the row capacity stays
+  EXPECT_EQ(wider.outerStride(), 40);
+  EXPECT_EQ(wide.memory_bytes(), 40 * 8 * sizeof(double));
+  wide.view(12, 5).setZero();
+  EXPECT_EQ(wide.memory_bytes(), 40 * 8 * sizeof(double));
 }
 
 }  // namespace

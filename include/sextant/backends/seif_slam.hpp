@@ -29,7 +29,7 @@
 #include "sextant/core/sparse_cholesky.hpp"
 #include "sextant/core/slot_set.hpp"
 #include "sextant/core/sparse_information.hpp"
-#include "sextant/core/square_workspace.hpp"
+#include "sextant/core/matrix_workspace.hpp"
 #include "sextant/core/update_result.hpp"
 #include "sextant/core/versioned_cache.hpp"
 
@@ -424,8 +424,8 @@ class SeifSlam {
   Undo* undo_ = nullptr;  ///< the open transaction's undo record
   VersionedCache<Factor> factor_;  ///< factorization of Omega at revision_ (thread-safe)
   VersionedCache<Eigen::VectorXd> correction_;  ///< Omega^-1 r at revision_ (exact_mean only)
-  SquareWorkspace block_workspace_;   ///< the dense robot-and-landmarks block of the step (scratch)
-  SquareWorkspace factor_workspace_;  ///< its Cholesky factor (scratch)
+  MatrixWorkspace block_workspace_;   ///< the dense robot-and-landmarks block of the step (scratch)
+  MatrixWorkspace factor_workspace_;  ///< its Cholesky factor (scratch)
   SlotSet marked_slots_;  ///< mark_slots' slots (scratch)
   /// The landmarks outside a recovered block whose residual this update's recoveries changed (scratch).
   SlotSet changed_residuals_;

@@ -26,28 +26,9 @@
 #include <vector>
 
 #include "sextant/core/error.hpp"
+#include "sextant/core/matrix_workspace.hpp"
 
 namespace sextant {
-
-/// Memory for a dense matrix that a computation reuses from one call to the next; it grows, never
-/// shrinks, and is not part of its owner's value (a copy starts empty).
-class ScratchMatrix {
- public:
-  ScratchMatrix() = default;
-  ScratchMatrix(const ScratchMatrix&) {}
-  ScratchMatrix& operator=(const ScratchMatrix&) { return *this; }
-  ScratchMatrix(ScratchMatrix&&) noexcept = default;
-  ScratchMatrix& operator=(ScratchMatrix&&) noexcept = default;
-
-  /// A rows x cols view of the memory (contents unspecified).
-  Eigen::Map<Eigen::MatrixXd> matrix(Eigen::Index rows, Eigen::Index cols) {
-    if (static_cast<std::size_t>(rows * cols) > memory_.size()) memory_.resize(static_cast<std::size_t>(rows * cols));
-    return {memory_.data(), rows, cols};
-  }
-
- private:
-  std::vector<double> memory_;
-};
 
 template <int B>
 class ProfileCholesky {
@@ -201,8 +182,8 @@ class ProfileCholesky {
     std::size_t reach = e;  // the oldest column a trailing row of the factor keeps below e
     for (std::size_t i = e; i < n; ++i) reach = std::min(reach, matrix_row(i).first);
     const Eigen::Index m = B * static_cast<Eigen::Index>(n - e), below = B * static_cast<Eigen::Index>(e - reach);
-    auto T = trailing_.matrix(m, m);
-    auto kept = kept_.matrix(m, below);
+    auto T = trailing_.view(m);
+    auto kept = kept_.view(m, below);
     for (std::size_t i = e; i < n; ++i) write_trailing_row(i, T, kept);
     if (below > 0) T.template selfadjointView<Eigen::Lower>().rankUpdate(kept, -1.0);
     for (Eigen::Index at = 0; at < m; at += B)  // the lower triangle, the part written and factorized
@@ -252,7 +233,7 @@ class ProfileCholesky {
   std::vector<Row> staged_rows_;    ///< copies of the rows the staged changes touch, and new rows
   std::vector<std::size_t> staged_ids_;  ///< the row of each staged copy
   std::vector<Row> staged_factor_;  ///< rows first_changed_ .. of the staged matrix's factor
-  ScratchMatrix trailing_, kept_;   ///< factorize()'s dense blocks, kept between calls (not part of the value)
+  MatrixWorkspace trailing_, kept_;  ///< factorize()'s dense blocks, kept between calls (scratch)
   bool factorized_ = false;
   std::size_t staged_count_ = 0;
   std::size_t first_changed_ = 0;
