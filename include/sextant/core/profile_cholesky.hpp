@@ -9,7 +9,7 @@
 /// Rows in chronological order (the poses of an online smoother) make e the oldest pose a new
 /// factor reaches: the work of a step depends on how far back it reaches, not on how many rows
 /// precede (docs/derivations/incremental_graph_slam.md). The trailing block is factorized densely
-/// (Eigen's blocked LLT).
+/// (Eigen's blocked LLT), in place in a MatrixWorkspace kept from one call to the next.
 ///
 /// Changes are a transaction: add() and append_row() stage copies of the rows they touch,
 /// factorize() computes the staged matrix's factor (solve() and last_inverse_block() then use it),
