@@ -14,6 +14,8 @@
 /// 12 x 12 blocks (1.2 KB an entry) every probe is a cache miss. Built on it, bit for bit the same,
 /// and with its memory kept from one solve to the next, `BM_GlobeGraphOneGlobalUpdate` was 1.16x
 /// slower (2026-12-06, four pairs against the tree, g++, one pinned core; 1.25x without the memory kept).
+/// This sum kept by GraphSlam between solves (clear() keeping the vector's capacity) was not faster
+/// either: 0.94x over five pairs the same evening. A solve builds its sum anew.
 
 #include <Eigen/Core>
 #include <cstdint>
