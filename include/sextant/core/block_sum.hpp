@@ -10,8 +10,8 @@
 /// contribution, bit for bit.
 ///
 /// Its index is a std::unordered_map beside the vector of sums, not core/dense_slot_map.hpp's map
-/// (which holds SEIF's 3 x 3 links): that map compares the keys stored in its entries, and with
-/// 12 x 12 blocks (1.2 KB an entry) every probe is a cache miss. Built on it, bit for bit the same,
+/// (which holds SEIF's 3 x 3 links), likely because that map compares the keys stored in its
+/// entries, 1.2 KB apart with 12 x 12 blocks (not profiled). Built on it, bit for bit the same,
 /// and with its memory kept from one solve to the next, `BM_GlobeGraphOneGlobalUpdate` was 1.16x
 /// slower (2026-12-06, four pairs against the tree, g++, one pinned core; 1.25x without the memory kept).
 /// This sum kept by GraphSlam between solves (clear() keeping the vector's capacity) was not faster
