@@ -10,12 +10,12 @@
 /// contribution, bit for bit.
 ///
 /// Its index is a std::unordered_map beside the vector of sums, not core/dense_slot_map.hpp's map
-/// (which holds SEIF's 3 x 3 links), likely because that map compares the keys stored in its
-/// entries, 1.2 KB apart with 12 x 12 blocks (not profiled). Built on it, bit for bit the same,
-/// and with its memory kept from one solve to the next, `BM_GlobeGraphOneGlobalUpdate` was 1.16x
-/// slower (2026-12-06, four pairs against the tree, g++, one pinned core; 1.25x without the memory kept).
-/// This sum kept by GraphSlam between solves (clear() keeping the vector's capacity) was not faster
-/// either: 0.94x over five pairs the same evening. A solve builds its sum anew.
+/// (which holds SEIF's 3 x 3 links): built on that map, bit for bit the same and with its memory
+/// kept from one solve to the next, `BM_GlobeGraphOneGlobalUpdate` was 1.16x slower (2026-12-06,
+/// four pairs against the tree, g++, one pinned core; 1.25x without the memory kept), likely because
+/// that map compares the keys stored in its entries, 1.2 KB apart with 12 x 12 blocks (not profiled).
+/// Nor is this sum kept by GraphSlam between solves (clear() keeping the vector's capacity): that was
+/// 1.06x slower over five pairs the same evening. A solve builds its sum anew.
 
 #include <Eigen/Core>
 #include <cstdint>
