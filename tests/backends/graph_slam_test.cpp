@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
+
 #include "sextant/backends/ekf_slam.hpp"
 #include "sextant/eval/runner.hpp"
 #include "sextant/models/beacon_ship_2d.hpp"
@@ -172,16 +174,28 @@ TEST(GraphSlam, RemoveLandmarkKeepsItsInformationAsALinearFactor) {
   EXPECT_THROW(graph.remove_landmark(removed), unknown_landmark_error);
 }
 
-TEST(GraphSlam, WarmStartFromAFilterReachesTheSameOptimum) {
-  const auto data = sim::simulate_ship_2d({.seed = 6, .num_steps = 300});
+/// A filter's estimate of a ship run to warm-start a graph from: its pose after every step (the prior
+/// first) and its map at the end.
+struct FilterStart {
+  std::vector<Eigen::Vector2d> poses;
+  Graph::MapEstimate map;
+};
+
+FilterStart ekf_start(const sim::Ship2DDataset& data) {
   EkfSlam<BeaconShip2D, BeaconOffset2D> ekf{data.motion, data.sensor, data.prior};
   const auto record = eval::run(ekf, data.steps);
-  std::vector<Eigen::Vector2d> poses{data.prior.mean};
-  for (const auto& step : record.steps) poses.push_back(step.pose.mean);
+  FilterStart start{{data.prior.mean}, ekf.map()};
+  for (const auto& step : record.steps) start.poses.push_back(step.pose.mean);
+  return start;
+}
+
+TEST(GraphSlam, WarmStartFromAFilterReachesTheSameOptimum) {
+  const auto data = sim::simulate_ship_2d({.seed = 6, .num_steps = 300});
+  const auto [poses, map] = ekf_start(data);
   Graph cold{data.motion, data.sensor, data.prior}, warm{data.motion, data.sensor, data.prior};
   eval::run(cold, data.steps);
   eval::run(warm, data.steps);
-  warm.warm_start(poses, ekf.map());
+  warm.warm_start(poses, map);
   EXPECT_LT(warm.cost(), cold.cost());  // the filter's estimate is a better start than dead reckoning
   cold.optimize();
   warm.optimize();
@@ -189,7 +203,31 @@ TEST(GraphSlam, WarmStartFromAFilterReachesTheSameOptimum) {
   for (std::size_t k = 0; k < poses.size(); ++k)
     worst = std::max(worst, (warm.pose_means()[k] - cold.pose_means()[k]).cwiseAbs().maxCoeff());
   EXPECT_LT(worst, 1e-6);
-  EXPECT_THROW(warm.warm_start(std::vector<Eigen::Vector2d>(3), ekf.map()), invalid_input_error);
+  EXPECT_THROW(warm.warm_start(std::vector<Eigen::Vector2d>(3), map), invalid_input_error);
+}
+
+// A filter that keeps a pool of landmarks holds few of them at the end (the visual-inertial runner's):
+// the others must move with the new trajectory, not stay where dead reckoning put them.
+TEST(GraphSlam, WarmStartPlacesTheLandmarksItIsNotGivenFromTheirFirstMeasurementAtTheNewPoses) {
+  const auto data = sim::simulate_ship_2d({.seed = 6, .num_steps = 300});
+  const auto [poses, map] = ekf_start(data);
+  Graph graph{data.motion, data.sensor, data.prior};
+  eval::run(graph, data.steps);
+  const Graph::MapEstimate given(map.begin(), map.begin() + 1);
+  graph.warm_start(poses, given);
+  std::map<LandmarkId, Eigen::Vector2d> started;
+  for (const auto& [id, mean] : graph.landmark_means()) started[id] = mean;
+  EXPECT_EQ(started.at(given[0].id), given[0].mean);
+  std::size_t placed = 0;
+  for (std::size_t k = 0; k < data.steps.size(); ++k)
+    for (const auto& observation : data.steps[k].observations) {
+      if (observation.landmark_id == given[0].id || !started.contains(observation.landmark_id)) continue;
+      EXPECT_LT((started.at(observation.landmark_id) - data.sensor.initialize(poses[k + 1], observation.z).m).norm(), 1e-12)
+          << "landmark " << observation.landmark_id << ", first seen at step " << k;
+      started.erase(observation.landmark_id);  // only its first measurement places it
+      ++placed;
+    }
+  EXPECT_EQ(placed + 1, map.size());
 }
 
 TEST(GraphSlam, SymbolicAnalysisIsReusedWhileThePatternIsUnchanged) {

@@ -75,6 +75,7 @@ TEST_F(VislamRunner, StereoViRunsEveryBackEndAndWritesTrajectoriesMapsAndScenes)
                             "SEIF-SLAM, 8 active", "FastSLAM 1.0, 10 particles", "FastSLAM 2.0, 10 particles"})
     EXPECT_TRUE(rows.contains(label)) << label << " not a row of:\n" << r.out;
   EXPECT_NE(r.out.find("GraphSLAM, LM"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("GraphSLAM from EKF, LM"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("nan"), std::string::npos) << "a score not computed must print as -:\n" << r.out;
   for (const auto& [label, row] : rows) {
     EXPECT_GT(rmse_of(row), 0.0) << label;  // scored against the simulator's truth
@@ -84,7 +85,7 @@ TEST_F(VislamRunner, StereoViRunsEveryBackEndAndWritesTrajectoriesMapsAndScenes)
   }
   const auto data = out / "stereo-vi";
   EXPECT_EQ(count_lines(data / "reference.tum"), 80u);
-  for (const char* key : {"dead_reckoning", "ekf", "ekf_fej", "seif", "graph", "fastslam1", "fastslam2"})
+  for (const char* key : {"dead_reckoning", "ekf", "ekf_fej", "seif", "graph", "graph_from_ekf", "fastslam1", "fastslam2"})
     EXPECT_EQ(count_lines(data / (std::string(key) + "_trajectory.tum")), 80u) << key;
   std::ifstream map(data / "ekf_map.csv");
   std::string header;

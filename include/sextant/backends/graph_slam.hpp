@@ -125,7 +125,11 @@ class GraphSlam {
   /// Marginalizes a landmark: its factors become one linear factor over the poses that saw it.
   void remove_landmark(LandmarkId id);
 
-  /// Replaces the current estimate (e.g. with a filter's trajectory and map) before optimize().
+  /// Replaces the current estimate before optimize() (e.g. with a filter's trajectory and map): every
+  /// pose, and the landmarks `map` lists; every other landmark starts again where update() started
+  /// it, at the inverse model of its first measurement, now from the new pose (a filter that keeps a
+  /// pool of landmarks no longer holds most of them at the end), or keeps its mean where the model
+  /// cannot place it from there (unobservable_error).
   void warm_start(std::span<const State> poses, const MapEstimate& map);
 
   /// The newest pose, O(1): its current mean, and as covariance its exact marginal as of the last

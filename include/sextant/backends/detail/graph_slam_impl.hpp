@@ -562,11 +562,24 @@ void GraphSlam<Motion, Sensor>::warm_start(std::span<const State> poses, const M
   if (poses.size() != poses_.size())
     throw invalid_input_error("warm_start: " + std::to_string(poses.size()) + " poses given, the graph has " +
                               std::to_string(poses_.size()));
-  Eigen::VectorXd means = landmarks_.means().stacked();
-  for (const auto& landmark : map) means.template segment<M>(M * landmarks_.slot(landmark.id)) = landmark.mean;
   for (const auto& pose : poses)
     if (!Space::is_finite(pose)) throw invalid_input_error("warm_start: a pose contains NaN or Inf");
+  Eigen::VectorXd means = landmarks_.means().stacked();
+  std::vector<bool> given(measurements_.size(), false);
+  for (const auto& landmark : map) {
+    const std::size_t slot = landmarks_.slot(landmark.id);
+    means.template segment<M>(M * slot) = landmark.mean;
+    given[slot] = true;
+  }
   if (!means.allFinite()) throw invalid_input_error("warm_start: a landmark contains NaN or Inf");
+  std::vector<LandmarkId> unplaceable;  // from the new pose: those keep their means
+  for (std::size_t slot = 0; slot < measurements_.size(); ++slot) {
+    if (given[slot]) continue;
+    const auto& first = measurements_[slot].front();
+    if (const auto init = initialize_if_observable(sensor_, poses[first.pose], first.z, landmarks_.id_at(slot),
+                                                   first.noise_scale, unplaceable))
+      means.template segment<M>(M * slot) = init->m;
+  }
   poses_.assign(poses.begin(), poses.end());
   landmarks_.means().stacked() = means;
   windows_done_ = true;
