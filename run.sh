@@ -17,6 +17,7 @@ cd "$(dirname "$0")"
 mode=${1:-main}
 [ $# -gt 0 ] && shift
 bash cmake/install_deps.sh
+source cmake/openblas_coretype.sh  # OpenBLAS's vector kernels on a CPU it does not know
 build=${SEXTANT_BUILD_DIR:-build}
 jobs=$(nproc 2>/dev/null || echo 2)
 # clang++ compiles sextant 2.2x faster than g++ and the outputs are bit-identical (docs/build_times.md);

@@ -19,6 +19,7 @@ set -euo pipefail
 commit=$1 program=$2 filter=$3 pairs=${4:-6}
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
+source cmake/openblas_coretype.sh  # both programs on OpenBLAS's vector kernels, as ./run.sh runs them
 cxx=${SEXTANT_CXX:-g++}
 short=$(git rev-parse --short "$commit")
 old=$root/build-bench-$short
