@@ -6,7 +6,7 @@
 # (docs/benchmarks.md, "OpenBLAS's kernels on a CPU it does not know"). A value set by the caller is kept.
 openblas_kernels_for_cpu() {  # prints the OPENBLAS_CORETYPE this CPU wants, or nothing without AVX2 + FMA
   local flags
-  flags=" $(grep -m1 '^flags' /proc/cpuinfo 2>/dev/null | cut -d: -f2) "
+  flags=" $(grep -m1 '^flags' /proc/cpuinfo 2>/dev/null | cut -d: -f2 || true) "  # none on other architectures
   local f
   for f in avx2 fma; do [[ $flags == *" $f "* ]] || return 0; done
   for f in avx512f avx512cd avx512bw avx512dq avx512vl; do [[ $flags == *" $f "* ]] || { echo Haswell; return 0; }; done
