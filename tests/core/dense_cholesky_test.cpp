@@ -126,7 +126,11 @@ TEST(DenseCholesky, ReadsOnlyTheLowerTriangle) {
   }
 }
 
-TEST(SymmetricRankUpdate, IsAlphaATransposeAPlusBetaCOnTheUpperTriangleOnBothPaths) {
+/// symmetric_rank_update<UpLo> against the dense product on the `UpLo` triangle, the other strict
+/// triangle untouched, at sizes on both sides of kLapackMinDimension.
+template <unsigned int UpLo>
+void check_symmetric_rank_update() {
+  constexpr unsigned int other = UpLo == Eigen::Lower ? Eigen::StrictlyUpper : Eigen::StrictlyLower;
   std::mt19937 rng(21);
   std::normal_distribution<double> normal;
   for (const Eigen::Index n : kSizes) {
@@ -136,18 +140,25 @@ TEST(SymmetricRankUpdate, IsAlphaATransposeAPlusBetaCOnTheUpperTriangleOnBothPat
       for (const double beta : {0.0, 1.0, 0.5}) {
         Eigen::MatrixXd C = C0;
         if (beta == 0.0)  // not read: garbage must not leak through
-          C.triangularView<Eigen::Upper>().setConstant(std::numeric_limits<double>::quiet_NaN());
-        symmetric_rank_update_upper(C, A, -1.5, beta);
+          C.triangularView<UpLo>().setConstant(std::numeric_limits<double>::quiet_NaN());
+        symmetric_rank_update<UpLo>(C, A, -1.5, beta);
         const Eigen::MatrixXd expected = -1.5 * A.transpose() * A + beta * C0;
         const double scale = expected.cwiseAbs().maxCoeff();
-        const Eigen::MatrixXd upper_error = (C - expected).triangularView<Eigen::Upper>();
-        EXPECT_LE(upper_error.cwiseAbs().maxCoeff(), 1e-13 * scale) << "n " << n << " k " << k << " beta " << beta;
-        EXPECT_EQ(Eigen::MatrixXd(C.triangularView<Eigen::StrictlyLower>()),
-                  Eigen::MatrixXd(C0.triangularView<Eigen::StrictlyLower>()))
-            << "the strict lower triangle changed, n " << n;
+        const Eigen::MatrixXd error = (C - expected).triangularView<UpLo>();
+        EXPECT_LE(error.cwiseAbs().maxCoeff(), 1e-13 * scale) << "n " << n << " k " << k << " beta " << beta;
+        EXPECT_EQ(Eigen::MatrixXd(C.triangularView<other>()), Eigen::MatrixXd(C0.triangularView<other>()))
+            << "the other triangle changed, n " << n;
       }
     }
   }
+}
+
+TEST(SymmetricRankUpdate, IsAlphaATransposeAPlusBetaCOnTheUpperTriangleOnBothPaths) {
+  check_symmetric_rank_update<Eigen::Upper>();
+}
+
+TEST(SymmetricRankUpdate, IsAlphaATransposeAPlusBetaCOnTheLowerTriangleOnBothPaths) {
+  check_symmetric_rank_update<Eigen::Lower>();
 }
 
 }  // namespace

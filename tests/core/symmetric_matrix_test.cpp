@@ -14,19 +14,6 @@ Eigen::MatrixXd random_spd(Eigen::Index n, unsigned seed) {
   return 0.5 * (S + S.transpose());  // exactly symmetric
 }
 
-TEST(SubtractGramLower, UpdatesTheLowerTriangleAsTheDenseProductAndLeavesTheUpperAlone) {
-  for (Eigen::Index n : {1, 5, 64, 65, 200}) {
-    Eigen::MatrixXd P = random_spd(n, static_cast<unsigned>(n));
-    const Eigen::MatrixXd upper_before = P.triangularView<Eigen::StrictlyUpper>();
-    const Eigen::MatrixXd W = 0.1 * Eigen::MatrixXd::Random(4, n);
-    const Eigen::MatrixXd expected = P - W.transpose() * W;
-    subtract_gram_lower(P, W);
-    const Eigen::MatrixXd lower_error = (P - expected).triangularView<Eigen::Lower>();
-    EXPECT_LT(lower_error.cwiseAbs().maxCoeff(), 1e-12) << n;
-    EXPECT_EQ(Eigen::MatrixXd(P.triangularView<Eigen::StrictlyUpper>()), upper_before) << n;
-  }
-}
-
 TEST(SymmetricBlocks, ReadFullColumnAndDiagonalBlocksFromTheLowerTriangle) {
   const Eigen::MatrixXd full = random_spd(9, 4);
   Eigen::MatrixXd lower = full.triangularView<Eigen::Lower>();

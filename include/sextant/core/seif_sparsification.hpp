@@ -55,8 +55,8 @@ SeifSparsificationChange<X> seif_sparsification_change(const Eigen::Matrix<doubl
   const auto llt_xx = cholesky_or_throw(D_xx, "robot block of the information matrix");
   const Eigen::MatrixXd W = llt_xx.matrixL().solve(D_xR);                                    // -W^T W on RR
   const Eigen::MatrixXd V = llt_S.matrixL().solve(D_xR.leftCols(n_kept) + out.robot_kept);  // +V^T V on ++
-  symmetric_rank_update_upper(change_on_RR, W, -1.0, 0.0);
-  symmetric_rank_update_upper(change_on_RR.topLeftCorner(n_kept, n_kept), V, 1.0, 1.0);
+  symmetric_rank_update<Eigen::Upper>(change_on_RR, W, -1.0, 0.0);
+  symmetric_rank_update<Eigen::Upper>(change_on_RR.topLeftCorner(n_kept, n_kept), V, 1.0, 1.0);
   return out;
 }
 

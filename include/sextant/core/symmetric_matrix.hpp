@@ -1,5 +1,5 @@
 #pragma once
-/// \file Symmetric dense matrix kernels: rank updates that keep exact symmetry, mirroring, and a
+/// \file Symmetric dense matrix kernels: blocks read from the lower triangle, mirroring, and a
 /// square matrix whose size grows with amortized O(1) reallocation (a map that grows by blocks).
 
 #include <Eigen/Core>
@@ -22,12 +22,6 @@ void mirror_lower_to_upper(Eigen::MatrixBase<Derived>& a) {
     for (Eigen::Index c = 0; c < width; ++c)
       for (Eigen::Index r = 0; r < c; ++r) a(j0 + r, j0 + c) = a(j0 + c, j0 + r);
   }
-}
-
-/// Lower triangle of a <- a - W^T W (a symmetric rank-k update that touches only the lower triangle).
-template <class DerivedA, class DerivedW>
-void subtract_gram_lower(Eigen::MatrixBase<DerivedA>& a, const Eigen::MatrixBase<DerivedW>& w) {
-  a.template selfadjointView<Eigen::Lower>().rankUpdate(w.transpose(), -1.0);
 }
 
 /// Columns [offset, offset + width) of a symmetric matrix of which only the lower triangle is

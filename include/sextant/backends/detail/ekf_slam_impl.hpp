@@ -8,6 +8,7 @@
 
 #include "sextant/core/iterate_settled.hpp"
 #include "sextant/core/landmark_init.hpp"
+#include "sextant/core/symmetric_rank_update.hpp"
 #include "sextant/core/validation.hpp"
 
 namespace sextant {
@@ -268,7 +269,7 @@ template <class Motion, class Sensor>
 void EkfSlam<Motion, Sensor>::apply(const Correction& correction) {
   auto P = cov_.view();
   if (options_.covariance_update == CovarianceUpdate::symmetric)
-    subtract_gram_lower(P, correction.W);
+    symmetric_rank_update<Eigen::Lower>(P, correction.W, -1.0, 1.0);  // P - W^T W (eq. 17)
   else
     P.template triangularView<Eigen::Lower>() = correction.P_joseph;
   if (correction.reset) reset_robot_tangent(P, *correction.reset);
