@@ -185,6 +185,9 @@ ViRun dead_reckoning_row(const ViData& d) {
   return out;
 }
 
+/// The key of GraphSLAM's row that starts from the EKF's estimate (vislam_choices, run_all).
+constexpr const char* kGraphFromEkf = "graph_from_ekf";
+
 /// The back-end configurations: the filters with the [vislam] gate, the EKF also with first-estimate
 /// Jacobians; GraphSLAM with Levenberg-Marquardt and a Huber loss at the gate's quantile (run_graph),
 /// and where the EKF runs too, GraphSLAM again from the EKF's estimate (docs/results/vislam.md: on
@@ -209,7 +212,7 @@ std::vector<BackendChoice> vislam_choices(const std::vector<BackendKind>& kinds,
   const auto graph = std::ranges::find(choices, BackendKind::graph, &BackendChoice::kind);
   if (with_ekf && graph != choices.end()) {
     auto from_ekf = *graph;
-    from_ekf.key = "graph_from_ekf";
+    from_ekf.key = kGraphFromEkf;
     from_ekf.label = "GraphSLAM from EKF";  // + ", LM, 100 iterations": the table's 38 characters
     choices.push_back(std::move(from_ekf));
   }
@@ -219,16 +222,16 @@ std::vector<BackendChoice> vislam_choices(const std::vector<BackendKind>& kinds,
 std::vector<ViRun> run_all(const ViData& d, const std::vector<BackendKind>& kinds, const RunnerConfig& c) {
   std::vector<ViRun> runs{dead_reckoning_row(d)};
   for (const auto& choice : vislam_choices(kinds, c)) {
-    std::optional<ViRun> start;  // a copy: runs grows below
-    if (choice.key == "graph_from_ekf") {
+    const ViRun* start = nullptr;  // into runs: run_graph has returned before runs grows
+    if (choice.key == kGraphFromEkf) {
       const auto ekf = std::ranges::find(runs, std::string("ekf"), &ViRun::key);
       if (ekf == runs.end() || ekf->failure) continue;  // no EKF estimate to start from: no row
-      start = *ekf;
+      start = &*ekf;
     }
     const auto failure = failure_of([&] {
       with_backend(choice, d.motion, d.sensor, d.prior, [&](auto& backend) {
         if constexpr (requires { backend.optimize(); })
-          runs.push_back(run_graph(backend, d, choice.key, choice.label, start ? &*start : nullptr));
+          runs.push_back(run_graph(backend, d, choice.key, choice.label, start));
         else  // the EKF's pose covariance after every frame, the others' every 10th (a SEIF's costs a factorization)
           runs.push_back(run_backend(backend, d, c.vislam.pool, choice.kind == BackendKind::ekf ? 1 : 10, choice.key,
                                      choice.label));
