@@ -801,6 +801,12 @@ inline std::vector<ConfigKey> fastslam_keys() {
      "linearizations of FastSLAM 2.0's proposal per update, each at the previous one's pose and landmarks (as "
      "[ekf] iterations; 1 = the textbook proposal): docs/results/iterated_ekf.md",
      [](RunnerConfig& c, const std::string& v) { c.fastslam.iterations = parse_integer<int>(v, 1, 100); }},
+    {"fastslam", "estimate", "filter",
+     "filter | path: score each step's pose as the step left it, or the path the particles hold at the end of the "
+     "run (FastSLAM's path posterior, a smoother's trajectory as GraphSLAM's row scores)",
+     [](RunnerConfig& c, const std::string& v) {
+       c.fastslam.keep_paths = parse_choice<bool>(v, {{"filter", false}, {"path", true}});
+     }},
     {"fastslam", "student_t_dof", "0",
      "the measurement noise as a Student-t of this many degrees of freedom (gross outliers): each update's noise "
      "scaled by (dof + NIS) / (dof + d), each weight the t density (0: Gaussian)",

@@ -34,8 +34,10 @@ inline std::string backend_label(BackendKind kind, const RunnerConfig& c) {
       return seif_label(kind == BackendKind::eseif || c.seif.sparsification == SeifSparsification::relocalization,
                         c.seif.max_active);
     case BackendKind::graph: return "GraphSLAM";
-    case BackendKind::fastslam1: return "FastSLAM 1.0, " + std::to_string(c.fastslam.particles) + " particles";
-    case BackendKind::fastslam2: return "FastSLAM 2.0, " + std::to_string(c.fastslam.particles) + " particles";
+    case BackendKind::fastslam1:
+    case BackendKind::fastslam2:
+      return std::string(kind == BackendKind::fastslam1 ? "FastSLAM 1.0, " : "FastSLAM 2.0, ") +
+             std::to_string(c.fastslam.particles) + (c.fastslam.keep_paths ? " part., path" : " particles");
   }
   return "?";
 }

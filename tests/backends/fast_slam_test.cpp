@@ -169,6 +169,70 @@ TEST(FastSlam, VersionTwoReportsTheMixtureOfItsProposalsNotItsDraws) {
   EXPECT_GT((pose.cov - particle.drawn_cov).determinant(), 0.0);  // the frame's uncertainty
 }
 
+TEST_P(FastVersions, WithOneParticleThePathPosteriorIsThePoseEachStepLeft) {
+  // One particle is the whole cloud, so its path is what pose() said after each step (FastSLAM 2.0's
+  // proposal, 1.0's draw), from the prior on. Before the first landmark pose() carries the frame's
+  // spread of its time and the path today's; keeping the paths changes no estimate.
+  const auto data = sim::simulate_ship_2d({.seed = 6, .num_steps = 40});
+  Fast fast{data.motion, data.sensor, data.prior, {.particles = 1, .version = GetParam(), .keep_paths = true}};
+  Fast plain{data.motion, data.sensor, data.prior, {.particles = 1, .version = GetParam()}};
+  EXPECT_THROW(plain.path_posterior(), invalid_input_error);
+  std::vector<Fast::PoseEstimate> left{data.prior};
+  std::size_t first_mapped = 0;
+  const std::vector<Fast::ObservationType> none;
+  for (std::size_t k = 0; k < data.steps.size(); ++k) {
+    for (Fast* f : {&fast, &plain}) {
+      f->predict(data.steps[k].control, data.steps[k].dt);
+      f->update(k < 3 ? none : data.steps[k].observations);  // three steps before the first landmark
+    }
+    left.push_back(fast.pose());
+    EXPECT_EQ(fast.pose().mean, plain.pose().mean) << k;
+    EXPECT_EQ(fast.pose().cov, plain.pose().cov) << k;
+    if (first_mapped == 0 && fast.num_landmarks() > 0) first_mapped = k + 1;
+  }
+  ASSERT_GT(first_mapped, 1u);
+  const auto path = fast.path_posterior();
+  ASSERT_EQ(path.poses.size(), left.size());
+  for (std::size_t j = 0; j < left.size(); ++j) {
+    EXPECT_LT((path.poses[j].mean - left[j].mean).norm(), 1e-12) << j;
+    if (j >= first_mapped) EXPECT_LT((path.poses[j].cov - left[j].cov).norm(), 1e-12 * left[j].cov.norm()) << j;
+    EXPECT_EQ(path.support[j], 1.0) << j;
+  }
+}
+
+TEST(FastSlam, ThePathPosteriorWeighsEveryEarlierPoseByTodaysWeights) {
+  // Each pose of the path is the mixture, over today's particles, of the pose their ancestor had
+  // then: at the last step the particles' own proposals, at the start one pose per first particle
+  // that still has descendants, weighed by its descendants' summed weight (counted here by
+  // Particle::ancestor, bookkeeping the paths do not share).
+  const auto data = sim::simulate_ship_2d({.seed = 3, .num_steps = 150});
+  constexpr std::size_t N = 40;
+  Fast fast{data.motion, data.sensor, data.prior, {.particles = N, .resample_threshold = 0.7, .keep_paths = true}};
+  for (const auto& step : data.steps) {
+    fast.predict(step.control, step.dt);
+    fast.update(step.observations);
+  }
+  ASSERT_GT(fast.resamplings(), 0u);
+  const auto path = fast.path_posterior();
+  ASSERT_EQ(path.poses.size(), data.steps.size() + 1);
+  const auto w = fast.weights();
+  Eigen::Vector2d today = Eigen::Vector2d::Zero();
+  std::map<std::size_t, double> by_ancestor;
+  for (std::size_t i = 0; i < N; ++i) {
+    today += w[i] * fast.particles()[i].drawn_from;
+    by_ancestor[fast.particles()[i].ancestor] += w[i];
+  }
+  EXPECT_LT((path.poses.back().mean - today).norm(), 1e-9 * today.norm());
+  EXPECT_NEAR(path.support.back(), fast.effective_sample_size(), 1e-9 * N);
+  double squares = 0.0;
+  for (const auto& [ancestor, weight] : by_ancestor) squares += weight * weight;
+  EXPECT_NEAR(path.support.front(), 1.0 / squares, 1e-9 * N);
+  EXPECT_LT(by_ancestor.size(), N);  // resampling dropped some first particles' lines
+  EXPECT_LT((path.poses.front().mean - data.prior.mean).norm(), 1e-12);  // each started at the prior's mean
+  for (std::size_t j = 1; j < path.support.size(); ++j)
+    EXPECT_GE(path.support[j], path.support[j - 1] - 1e-9) << j;  // lines only meet going back
+}
+
 INSTANTIATE_TEST_SUITE_P(BothVersions, FastVersions, ::testing::Values(FastSlamVersion::v1, FastSlamVersion::v2));
 
 /// Squared distance of FastSLAM 2.0's velocity estimate (30 particles) from the exact Kalman

@@ -18,6 +18,7 @@
 #include "sextant/core/conditionally_linear.hpp"
 #include "sextant/core/gaussian.hpp"
 #include "sextant/core/innovation_gate.hpp"
+#include "sextant/core/particle_path.hpp"
 #include "sextant/core/persistent_array.hpp"
 #include "sextant/core/student_t.hpp"
 #include "sextant/core/update_result.hpp"
@@ -79,6 +80,11 @@ struct FastSlamOptions {
   /// sighting far off its landmark neither drags the pose and landmark nor kills the particle that has
   /// them right. The new-landmark weight takes the same density. 0 (the default) = Gaussian.
   double student_t_dof = 0.0;
+  /// Keep each particle's path (core/particle_path.hpp) for path_posterior(), FastSLAM's estimate of
+  /// the whole path given every measurement so far. Off: no path is kept and a step costs nothing
+  /// more. On: one pose per particle a step, shared between copies (memory ~ steps + particles x the
+  /// depth where their ancestries meet).
+  bool keep_paths = false;
 };
 
 /// One landmark of one particle: an EKF over its position (eqs. 75-78).
@@ -124,6 +130,11 @@ class FastSlam {
     State drawn_from;
     Eigen::Matrix<double, X, X> drawn_cov = Eigen::Matrix<double, X, X>::Zero();
     std::size_t ancestor = 0;  ///< which of the first step's particles this one descends from
+    /// After each step from the prior on, the Gaussian the particle's pose was drawn from (drawn_from
+    /// and drawn_cov after the step's update; after a predict, the motion's prediction) rather than
+    /// the draw, whose spread path_posterior() would only add as noise (options().keep_paths; empty
+    /// otherwise).
+    ParticlePath<PoseEstimate> path;
     /// x is a point from here on: its weight is about to depend on the draw.
     void forget_proposal() {
       drawn_from = x;
@@ -166,6 +177,18 @@ class FastSlam {
   /// +inf where every particle reports a Gaussian (FastSLAM 2.0's proposals, a predict's motion, the
   /// dead-reckoned frame before the first landmark).
   double pose_sample_support() const;
+  /// FastSLAM's estimate of the path (options().keep_paths): entry 0 the prior, entry k the pose
+  /// after the k-th step, each the weighted mixture, over today's particles, of the pose their
+  /// ancestor had then (Montemerlo et al. 2002: the particles sample the path posterior; the weights
+  /// of the last step weigh every earlier pose of a path). The frame's uncertainty of today is added
+  /// to each. `support` is 1 / sum of the squared weights of the distinct ancestors at each step: 1
+  /// where every path runs through one ancestor (path degeneracy), the covariance there being that
+  /// one ancestor's proposal alone.
+  struct PathPosterior {
+    std::vector<PoseEstimate> poses;
+    std::vector<double> support;
+  };
+  PathPosterior path_posterior() const;
   MapEstimate map() const;
   LandmarkEstimate<M> landmark(LandmarkId id) const;
   bool has_landmark(LandmarkId id) const;
@@ -210,6 +233,10 @@ class FastSlam {
   void predict_without_map(const Control& u, double dt);
   void fix_frame_if_mapped(Transaction& t) const;
   void commit(Transaction&& t);
+  /// With options().keep_paths: each particle's path gains its pose after a predict (extend), or its
+  /// last pose becomes the one the update drew (settle).
+  void extend_paths(Transaction& t) const;
+  void settle_paths(Transaction& t) const;
 
   /// The particle after a draw from N(mean, cov): its sampled entries drawn, its tail kept Gaussian.
   void draw_into(Particle& particle, const PoseEstimate& gaussian, std::mt19937_64& rng) const;

@@ -98,6 +98,23 @@ void add_aligned_errors(Summary& out, const Map& map, const Dataset& dataset, in
   }
   out.map_error_aligned = aligned_position_errors(estimated, true_points, static_cast<int>(Point::RowsAtCompileTime));
 }
+
+/// Scores a smoothed trajectory (entry 0 the start, entry k the pose after step k) and the final map.
+template <class Space, class Summary, class Poses, class Map, class Dataset>
+void score_trajectory(Summary& out, const Poses& trajectory, const Map& final_map, const Dataset& dataset,
+                      int position_dim) {
+  for (std::size_t k = 1; k < trajectory.size(); ++k) {
+    const auto error = Space::minus(trajectory[k].mean, dataset.true_poses[k]);
+    out.pose_error.push_back(position_error<Space>(trajectory[k].mean, dataset.true_poses[k], position_dim));
+    out.pose_nees.push_back(nees_or_infinity(error, trajectory[k].cov));
+    out.trajectory.push_back(trajectory[k].mean);
+  }
+  auto map = evaluate_map(final_map, dataset.true_landmarks);
+  out.map_error = std::move(map.errors);
+  out.map_nees = std::move(map.nees);
+  out.map_error_over_time = mean(out.map_error);
+  add_aligned_errors(out, final_map, dataset, position_dim);
+}
 /// predict + update over every step of the data set (for_each_step), each timed into out.seconds
 /// and out.total_seconds; after(k) once step k is done.
 template <class Backend, class Dataset, class Summary, class After>
@@ -177,19 +194,29 @@ RunSummary<typename Backend::State> evaluate_smoothed_run(Backend& backend, cons
   RunSummary<typename Backend::State> out;
   detail::run_timed_steps(backend, dataset, out, on_step, on_error);
   detail::optimize_timed(backend, out);
-  const auto trajectory = backend.trajectory();
-  for (std::size_t k = 1; k < trajectory.size(); ++k) {
-    const auto error = Space::minus(trajectory[k].mean, dataset.true_poses[k]);
-    out.pose_error.push_back(detail::position_error<Space>(trajectory[k].mean, dataset.true_poses[k], position_dim));
-    out.pose_nees.push_back(nees_or_infinity(error, trajectory[k].cov));
-    out.trajectory.push_back(trajectory[k].mean);
-  }
-  const auto final_map = backend.map();
-  auto map = evaluate_map(final_map, dataset.true_landmarks);
-  out.map_error = std::move(map.errors);
-  out.map_nees = std::move(map.nees);
-  out.map_error_over_time = mean(out.map_error);
-  detail::add_aligned_errors(out, final_map, dataset, position_dim);
+  detail::score_trajectory<Space>(out, backend.trajectory(), backend.map(), dataset, position_dim);
+  return out;
+}
+
+/// A particle filter scored by its path posterior (path_posterior(): the path its particles hold
+/// after the last step, weighted by the last weights), as full SLAM's smoothed trajectory is; the
+/// path's support per step as pose_support. `seconds` holds each step's time; total_seconds adds
+/// the path's extraction.
+template <class Backend, class Dataset, class OnStep = NoStepCallback>
+  requires requires(const Backend& b) { b.path_posterior(); }
+RunSummary<typename Backend::State> evaluate_path_run(Backend& backend, const Dataset& dataset, int position_dim = -1,
+                                                      OnStep on_step = {}, StepErrors on_error = StepErrors::propagate) {
+  using Space = typename Backend::Space;
+  RunSummary<typename Backend::State> out;
+  detail::run_timed_steps(backend, dataset, out, on_step, on_error);
+  const auto start = std::chrono::steady_clock::now();
+  const auto path = backend.path_posterior();
+  out.total_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (path.poses.size() != out.seconds.size() + 1)
+    throw invalid_input_error("evaluate_path_run: the path holds " + std::to_string(path.poses.size()) + " poses for " +
+                              std::to_string(out.seconds.size()) + " steps and the start (a predict failed)");
+  detail::score_trajectory<Space>(out, path.poses, backend.map(), dataset, position_dim);
+  out.pose_support.assign(path.support.begin() + 1, path.support.end());
   return out;
 }
 

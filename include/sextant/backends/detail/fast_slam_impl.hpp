@@ -42,6 +42,7 @@ FastSlam<Motion, Sensor, Map>::FastSlam(Motion motion, Sensor sensor, const Pose
     particles_[n].cov = tail;
     particles_[n].forget_proposal();
     particles_[n].ancestor = n;
+    if (options_.keep_paths) particles_[n].path.push_back({prior.mean, tail});
   }
   frame_cov_ = prior.cov - tail;
 }
@@ -88,6 +89,18 @@ void FastSlam<Motion, Sensor, Map>::commit(Transaction&& t) {
   best_ = t.best;
 }
 
+template <class Motion, class Sensor, template <class> class Map>
+void FastSlam<Motion, Sensor, Map>::extend_paths(Transaction& t) const {
+  if (!options_.keep_paths) return;
+  for (auto& particle : t.particles) particle.path.push_back(pose_component(particle, t.pending));
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+void FastSlam<Motion, Sensor, Map>::settle_paths(Transaction& t) const {
+  if (!options_.keep_paths) return;
+  for (auto& particle : t.particles) particle.path.replace_back({particle.drawn_from, particle.drawn_cov});
+}
+
 /// Dead reckoning of the common pose and of its covariance, Sigma <- G Sigma G^T + R, split into the
 /// frame's part and the particles' conditionally linear tail (which stays theirs: no rigid motion).
 template <class Motion, class Sensor, template <class> class Map>
@@ -106,6 +119,7 @@ void FastSlam<Motion, Sensor, Map>::predict_without_map(const Control& u, double
   }
   t.estimate = PoseEstimate{p.x, total};
   t.support = std::numeric_limits<double>::infinity();
+  extend_paths(t);
   commit(std::move(t));
 }
 
@@ -134,6 +148,7 @@ void FastSlam<Motion, Sensor, Map>::predict(const Control& u, double dt) {
     for (const auto& particle : t.particles) checked_motion_prediction(motion_, particle.x, u, dt);
   t.estimate = cloud_estimate(t.particles, t.pending);  // pose() after an accepted predict cannot throw
   t.support = point_support(t.particles, t.pending, t.frame_fixed);
+  extend_paths(t);
   commit(std::move(t));
 }
 
@@ -477,6 +492,7 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update(std::span<const ObservationTy
     index[observation.landmark_id] = id_of_index.size();
     id_of_index.push_back(observation.landmark_id);
   }
+  settle_paths(t);
   commit(std::move(t));
   index_.swap(index);
   id_of_index_.swap(id_of_index);
@@ -544,6 +560,7 @@ UpdateResult FastSlam<Motion, Sensor, Map>::update_unassociated(std::span<const 
     map_unassociated(t.particles[n], measurements, match[parents[n]], true, t);
   t.next_unassociated_id += measurements.size();
   fix_frame_if_mapped(t);
+  settle_paths(t);
   commit(std::move(t));
   if (most_likely) *most_likely = std::move(chosen_ids);
   return {measurements.size() - initialized, initialized, {}, {}};
@@ -701,6 +718,37 @@ auto FastSlam<Motion, Sensor, Map>::cloud_estimate(const std::vector<Particle>& 
                                           [&](std::size_t i) { return components[i].cov; });
   PoseEstimate out{Space::plus(reference, moments.mean), symmetrized(moments.cov + frame_cov_)};
   if (!Space::is_finite(out.mean) || !out.cov.allFinite()) throw numerical_error("FastSLAM cloud pose estimate is not finite");
+  return out;
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::path_posterior() const -> PathPosterior {
+  if (!options_.keep_paths)
+    throw invalid_input_error("FastSlam::path_posterior: the paths were not kept (FastSlamOptions::keep_paths)");
+  using Path = ParticlePath<PoseEstimate>;
+  std::vector<const Path*> paths;
+  for (const auto& particle : particles_) paths.push_back(&particle.path);
+  PathPosterior out;
+  out.poses.resize(particles_.front().path.size());
+  out.support.resize(out.poses.size());
+  std::vector<double> w;
+  std::vector<Eigen::Matrix<double, X, 1>> d;
+  Path::walk_back(paths, normalized_weights(particles_), [&](std::size_t j, std::span<const typename Path::WeightedPose> poses) {
+    w.clear();
+    d.clear();
+    std::size_t heaviest = 0;
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      w.push_back(poses[i].weight);
+      if (poses[i].weight > poses[heaviest].weight) heaviest = i;
+    }
+    const State& reference = poses[heaviest].pose->mean;
+    for (const auto& p : poses) d.push_back(Space::minus(p.pose->mean, reference));
+    const auto moments = mixture_moments<X>(w, [&](std::size_t i) { return d[i]; },
+                                            [&](std::size_t i) { return poses[i].pose->cov; });
+    out.poses[j] = in_canonical_coordinates<Space>(
+        PoseEstimate{Space::plus(reference, moments.mean), symmetrized(moments.cov + frame_cov_)});
+    out.support[j] = 1.0 / std::inner_product(w.begin(), w.end(), w.begin(), 0.0);
+  });
   return out;
 }
 
