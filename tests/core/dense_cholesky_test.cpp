@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cstdlib>
 #include <limits>
 #include <random>
@@ -126,9 +127,9 @@ TEST(DenseCholesky, ReadsOnlyTheLowerTriangle) {
   }
 }
 
-/// symmetric_rank_update<UpLo> against the dense product on the `UpLo` triangle, the other strict
+/// symmetric_rank_update<UpLo, Of> against the dense product on the `UpLo` triangle, the other strict
 /// triangle untouched, at sizes on both sides of kLapackMinDimension.
-template <unsigned int UpLo>
+template <unsigned int UpLo, RankUpdateOf Of = RankUpdateOf::rows>
 void check_symmetric_rank_update() {
   constexpr unsigned int other = UpLo == Eigen::Lower ? Eigen::StrictlyUpper : Eigen::StrictlyLower;
   std::mt19937 rng(21);
@@ -141,7 +142,10 @@ void check_symmetric_rank_update() {
         Eigen::MatrixXd C = C0;
         if (beta == 0.0)  // not read: garbage must not leak through
           C.triangularView<UpLo>().setConstant(std::numeric_limits<double>::quiet_NaN());
-        symmetric_rank_update<UpLo>(C, A, -1.5, beta);
+        if constexpr (Of == RankUpdateOf::rows)
+          symmetric_rank_update<UpLo>(C, A, -1.5, beta);
+        else
+          symmetric_rank_update<UpLo, Of>(C, Eigen::MatrixXd(A.transpose()), -1.5, beta);  // the same vectors as columns
         const Eigen::MatrixXd expected = -1.5 * A.transpose() * A + beta * C0;
         const double scale = expected.cwiseAbs().maxCoeff();
         const Eigen::MatrixXd error = (C - expected).triangularView<UpLo>();
@@ -159,6 +163,31 @@ TEST(SymmetricRankUpdate, IsAlphaATransposeAPlusBetaCOnTheUpperTriangleOnBothPat
 
 TEST(SymmetricRankUpdate, IsAlphaATransposeAPlusBetaCOnTheLowerTriangleOnBothPaths) {
   check_symmetric_rank_update<Eigen::Lower>();
+}
+
+TEST(SymmetricRankUpdate, OfColumnsIsAlphaAATransposePlusBetaCOnBothTrianglesAndPaths) {
+  check_symmetric_rank_update<Eigen::Lower, RankUpdateOf::columns>();
+  check_symmetric_rank_update<Eigen::Upper, RankUpdateOf::columns>();
+}
+
+TEST(DenseCholesky, RightSolveWithTheTransposedFactorIsBTimesLInverseTransposedOnBothPaths) {
+  // The EKF's W^T = C L^-T, in place: against the dense inverse, and L's strict upper triangle
+  // (NaN here) never read, with b of rows on both sides of kLapackMinDimension.
+  std::mt19937 rng(22);
+  std::normal_distribution<double> normal;
+  for (const Eigen::Index rows : kSizes)
+    for (const Eigen::Index k : {Eigen::Index{1}, Eigen::Index{6}, Eigen::Index{70}}) {
+      Eigen::MatrixXd factor = random_spd(k, 31 + static_cast<unsigned>(k));
+      cholesky_in_place_or_throw(factor, "the test block");
+      const Eigen::MatrixXd L = factor.triangularView<Eigen::Lower>();
+      factor.triangularView<Eigen::StrictlyUpper>().setConstant(std::numeric_limits<double>::quiet_NaN());
+      const Eigen::MatrixXd b0 = Eigen::MatrixXd::NullaryExpr(rows, k, [&] { return normal(rng); });
+      Eigen::MatrixXd b = b0;
+      right_solve_lower_transposed(factor, b);
+      const Eigen::MatrixXd expected = b0 * L.transpose().inverse();
+      EXPECT_LE((b - expected).cwiseAbs().maxCoeff(), 1e-12 * std::max(1.0, expected.cwiseAbs().maxCoeff()))
+          << "rows " << rows << " k " << k;
+    }
 }
 
 }  // namespace

@@ -151,7 +151,7 @@ class EkfSlam {
   struct Correction {
     Eigen::VectorXd delta;
     State x;                   ///< plus(x, delta_x), the corrected robot state
-    Eigen::MatrixXd W;         ///< symmetric form: L^-1 C^T (Zk x n), P' = P - W^T W
+    Eigen::MatrixXd Wt;        ///< symmetric form: C L^-T (n x Zk), P' = P - Wt Wt^T
     Eigen::MatrixXd P_joseph;  ///< Joseph form: the whole corrected P
     /// G = plus_jacobian(x, delta_x): the corrected P, held in the tangent at the old x, is read at
     /// the new one as G P G^T on the robot's rows (docs/derivations/state_space_jacobians.md); none

@@ -200,10 +200,11 @@ auto EkfSlam<Motion, Sensor>::compute_correction(const std::vector<Linearized>& 
     if (out.reset && !out.reset->allFinite()) throw numerical_error("EKF covariance reset is not finite");
   }
   if (options_.covariance_update == CovarianceUpdate::symmetric) {
-    out.W = llt.matrixL().solve(C.transpose());
+    out.Wt = std::move(C);
+    right_solve_lower_transposed(llt.matrixLLT(), out.Wt);  // W^T = (L^-1 C^T)^T, in C's memory
     // |(W^T W)_ij| <= max_i |W_i|^2: with that and |P| below half the double range, P - W^T W is finite.
-    const double largest = out.W.size() ? out.W.colwise().squaredNorm().maxCoeff() : 0.0;
-    if (!out.W.allFinite() || !(largest < 0.25 * std::numeric_limits<double>::max()))
+    const double largest = out.Wt.size() ? out.Wt.rowwise().squaredNorm().maxCoeff() : 0.0;
+    if (!out.Wt.allFinite() || !(largest < 0.25 * std::numeric_limits<double>::max()))
       throw numerical_error("EKF covariance correction would overflow");
   } else {
     const Eigen::MatrixXd K = llt.solve(C.transpose()).transpose();
@@ -269,7 +270,7 @@ template <class Motion, class Sensor>
 void EkfSlam<Motion, Sensor>::apply(const Correction& correction) {
   auto P = cov_.view();
   if (options_.covariance_update == CovarianceUpdate::symmetric)
-    symmetric_rank_update<Eigen::Lower>(P, correction.W, -1.0, 1.0);  // P - W^T W (eq. 17)
+    symmetric_rank_update<Eigen::Lower, RankUpdateOf::columns>(P, correction.Wt, -1.0, 1.0);  // P - W^T W (eq. 17)
   else
     P.template triangularView<Eigen::Lower>() = correction.P_joseph;
   if (correction.reset) reset_robot_tangent(P, *correction.reset);
