@@ -79,14 +79,14 @@ BackendRun<Dataset> run_backend(const BackendChoice& choice, const Dataset& data
   const auto evaluate = [&](auto& backend) {
     if constexpr (requires { data.has_ground_truth(); })
       if (!data.has_ground_truth()) return eval::record_unscored_run(backend, data, on_step, on_error);
-    if constexpr (requires { backend.optimize(); })
+    if constexpr (requires { backend.optimize(); }) {
       return eval::evaluate_smoothed_run(backend, data, scoring.position_dim, on_step, on_error);
-    else if constexpr (requires { backend.path_posterior(); }) {
-      if (backend.options().keep_paths)  // [fastslam] estimate = path
-        return eval::evaluate_path_run(backend, data, scoring.position_dim, on_step, on_error);
+    } else {
+      if constexpr (requires { backend.path_posterior(); })
+        if (backend.options().keep_paths)  // [fastslam] estimate = path
+          return eval::evaluate_path_run(backend, data, scoring.position_dim, on_step, on_error);
       return eval::evaluate_run(backend, data, scoring.position_dim, on_step, on_error);
-    } else
-      return eval::evaluate_run(backend, data, scoring.position_dim, on_step, on_error);
+    }
   };
   with_backend(choice, data.motion, data.sensor, data.prior, [&](auto& backend) {
     if (c.association.method && associates(choice.kind)) {  // the ids withheld and associated

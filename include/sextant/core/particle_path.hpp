@@ -24,7 +24,8 @@ class ParticlePath {
     mutable std::shared_ptr<const Node> before;
     std::size_t size;  ///< poses from the first up to this one
 
-    Node(Pose p, std::shared_ptr<const Node> b) : pose(std::move(p)), before(std::move(b)), size(before ? before->size + 1 : 1) {}
+    Node(Pose p, std::shared_ptr<const Node> b)
+        : pose(std::move(p)), before(std::move(b)), size(before ? before->size + 1 : 1) {}
     Node(const Node&) = delete;
     Node& operator=(const Node&) = delete;
     /// Releases the poses before this one in a loop, as far as no other path shares them.
@@ -79,7 +80,8 @@ class ParticlePath {
   /// Paths through one node become one entry holding their summed weight.
   static void merge_shared(std::vector<std::pair<const Node*, double>>& level) {
     if (level.size() < 2) return;
-    std::sort(level.begin(), level.end(), [](const auto& a, const auto& b) { return std::less<const Node*>{}(a.first, b.first); });
+    std::sort(level.begin(), level.end(),
+              [](const auto& a, const auto& b) { return std::less<const Node*>{}(a.first, b.first); });
     std::size_t kept = 0;
     for (std::size_t i = 1; i < level.size(); ++i)
       if (level[i].first == level[kept].first)

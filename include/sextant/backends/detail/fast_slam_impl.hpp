@@ -733,7 +733,7 @@ auto FastSlam<Motion, Sensor, Map>::path_posterior() const -> PathPosterior {
   out.support.resize(out.poses.size());
   std::vector<double> w;
   std::vector<Eigen::Matrix<double, X, 1>> d;
-  Path::walk_back(paths, normalized_weights(particles_), [&](std::size_t j, std::span<const typename Path::WeightedPose> poses) {
+  const auto visit = [&](std::size_t j, std::span<const typename Path::WeightedPose> poses) {
     w.clear();
     d.clear();
     std::size_t heaviest = 0;
@@ -748,7 +748,8 @@ auto FastSlam<Motion, Sensor, Map>::path_posterior() const -> PathPosterior {
     out.poses[j] = in_canonical_coordinates<Space>(
         PoseEstimate{Space::plus(reference, moments.mean), symmetrized(moments.cov + frame_cov_)});
     out.support[j] = 1.0 / std::inner_product(w.begin(), w.end(), w.begin(), 0.0);
-  });
+  };
+  Path::walk_back(paths, normalized_weights(particles_), visit);
   return out;
 }
 
