@@ -52,7 +52,7 @@ struct MrclamOptions {
   /// millions of steps.
   double max_gap = 60.0;
   /// The most steps a run may be cut into (10^6 steps of 0.25 s are 69 hours; Dataset6's robots
-  /// have about 27000); more is an error before any step is made.
+  /// have 3293-4212 with the defaults); more is an error before any step is made.
   std::size_t max_steps = 1'000'000;
   /// Beyond these a value is used but listed as implausible (MrclamRun::implausible): |v| in m/s
   /// (Dataset6's largest 0.086; an iRobot Create drives at most 0.5), |w| in rad/s (largest 0.57),
