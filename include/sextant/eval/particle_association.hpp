@@ -46,6 +46,10 @@ class ParticleAssociation : public WithheldIdsRun<ParticleAssociation<Backend>, 
     return result;
   }
 
+  const auto& options() const { return this->backend_.options(); }
+  /// FastSLAM's path posterior (FastSlamOptions::keep_paths): the ids enter no pose.
+  auto path_posterior() const { return this->backend_.path_posterior(); }
+
  private:
   std::size_t handed_over_ = 0;  ///< measurements handed to update_unassociated so far
 };
