@@ -339,6 +339,8 @@ class FastSlam {
                                                  std::span<const Measurement> measurements, bool proposal) const;
   std::vector<std::size_t> normalize_and_resample(Transaction& t) const;
   PoseEstimate cloud_estimate(const std::vector<Particle>& cloud, const std::vector<PendingMotion>& pending) const;
+  template <class Component>
+  PoseEstimate mixture_in_frame(const std::vector<double>& w, std::size_t reference, Component&& component) const;
   PoseEstimate pose_component(const Particle& particle, const std::vector<PendingMotion>& pending) const;
   double point_support(const std::vector<Particle>& cloud, const std::vector<PendingMotion>& pending,
                        bool frame_fixed) const;

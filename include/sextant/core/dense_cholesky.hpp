@@ -48,8 +48,8 @@ inline bool factorize_lower_in_place(Eigen::Ref<Eigen::MatrixXd> a) {
 
 /// b <- b L^-T in place, L the lower triangle of `factor` (a Cholesky factor: b L^-T = (L^-1 b^T)^T,
 /// the EKF's W^T). With `sextant::lapack` linked and b of kLapackMinDimension rows or more, BLAS's
-/// dtrsm: 5x Eigen's solve at the thesis's globe (11,289 x 360, with OpenBLAS's AVX2 kernels), and
-/// no transposed copy of b.
+/// dtrsm: 7.4x Eigen's solve at the thesis's last globe frame (11,289 x 360, one core; docs/benchmarks.md),
+/// and no transposed copy of b.
 inline void right_solve_lower_transposed(Eigen::Ref<const Eigen::MatrixXd> factor, Eigen::Ref<Eigen::MatrixXd> b) {
 #ifdef SEXTANT_HAS_LAPACK
   constexpr Eigen::Index int_max = std::numeric_limits<int>::max();

@@ -1,11 +1,12 @@
 #pragma once
-/// \file The symmetric rank-k update C <- alpha A^T A + beta C on one triangle of C (BLAS's dsyrk):
-/// SEIF's sparsification changes the links of all ~260 landmarks it touches by rank-X products
-/// (X = 12 on the 12D camera, a ~780 x 780 triangle a frame at the thesis's scale), and the EKF's
-/// correction is P - W^T W with W the k observations' L^-1 (P H^T)^T (rank 360 on an 11,289 x 11,289
-/// triangle at that scale; its W^T, n x 360, as columns). With `sextant::lapack` linked (OpenBLAS, which picks the CPU's vector
-/// instructions when it is loaded; core/dense_cholesky.hpp) triangles of kLapackMinDimension and more
-/// go to its dsyrk, otherwise, and below, Eigen's rank update. dsyrk was 1.2-3.3x Eigen's with
+/// \file The symmetric rank-k update C <- alpha A^T A + beta C (or alpha A A^T + beta C) on one
+/// triangle of C (BLAS's dsyrk): SEIF's sparsification changes the links of all ~260 landmarks it
+/// touches by rank-X products (X = 12 on the 12D camera, a ~780 x 780 triangle a frame at the thesis's
+/// scale), and the EKF's correction is P - W^T W with W the k observations' L^-1 (P H^T)^T (rank 360 on
+/// an 11,289 x 11,289 triangle at that scale, W^T given as n x 360 columns). With `sextant::lapack`
+/// linked (OpenBLAS, which picks the CPU's vector instructions when it is loaded;
+/// core/dense_cholesky.hpp) triangles of kLapackMinDimension and more go to its dsyrk, otherwise, and
+/// below, Eigen's rank update. dsyrk was 1.2-3.3x Eigen's with
 /// OpenBLAS's AVX2 kernels and 1.2-6.8x with its AVX-512 ones for n from 70 to 6000 and k from 2 to
 /// 360, 0.91-1.45x with its SSE3 ones (a build without -march flags; docs/benchmarks.md).
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "sextant/core/seconds_since.hpp"
 #include "sextant/eval/alignment.hpp"
 #include "sextant/eval/metrics.hpp"
 #include "sextant/eval/run_scores.hpp"
@@ -211,7 +212,7 @@ RunSummary<typename Backend::State> evaluate_path_run(Backend& backend, const Da
   detail::run_timed_steps(backend, dataset, out, on_step, on_error);
   const auto start = std::chrono::steady_clock::now();
   const auto path = backend.path_posterior();
-  out.total_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.total_seconds += seconds_since(start);
   if (path.poses.size() != out.seconds.size() + 1)
     throw invalid_input_error("evaluate_path_run: the path holds " + std::to_string(path.poses.size()) + " poses for " +
                               std::to_string(out.seconds.size()) + " steps and the start (a predict failed)");

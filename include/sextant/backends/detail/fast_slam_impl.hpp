@@ -711,14 +711,26 @@ auto FastSlam<Motion, Sensor, Map>::cloud_estimate(const std::vector<Particle>& 
   std::vector<PoseEstimate> components;
   components.reserve(cloud.size());
   for (const auto& particle : cloud) components.push_back(pose_component(particle, pending));
-  const State reference = components[heaviest_particle(cloud)].mean;
-  std::vector<Eigen::Matrix<double, X, 1>> d;
-  for (const auto& component : components) d.push_back(Space::minus(component.mean, reference));
-  const auto moments = mixture_moments<X>(w, [&](std::size_t i) { return d[i]; },
-                                          [&](std::size_t i) { return components[i].cov; });
-  PoseEstimate out{Space::plus(reference, moments.mean), symmetrized(moments.cov + frame_cov_)};
+  PoseEstimate out = mixture_in_frame(w, heaviest_particle(cloud), [&](std::size_t i) -> const PoseEstimate& {
+    return components[i];
+  });
   if (!Space::is_finite(out.mean) || !out.cov.allFinite()) throw numerical_error("FastSLAM cloud pose estimate is not finite");
   return out;
+}
+
+/// The mixture of the pose Gaussians component(i) weighed by w[i] (within plus between), moment-
+/// matched in the tangent space at component(reference)'s mean, plus the frame's uncertainty.
+template <class Motion, class Sensor, template <class> class Map>
+template <class Component>
+auto FastSlam<Motion, Sensor, Map>::mixture_in_frame(const std::vector<double>& w, std::size_t reference,
+                                                     Component&& component) const -> PoseEstimate {
+  const State at = component(reference).mean;
+  std::vector<Eigen::Matrix<double, X, 1>> d;
+  d.reserve(w.size());
+  for (std::size_t i = 0; i < w.size(); ++i) d.push_back(Space::minus(component(i).mean, at));
+  const auto moments = mixture_moments<X>(w, [&](std::size_t i) { return d[i]; },
+                                          [&](std::size_t i) { return component(i).cov; });
+  return {Space::plus(at, moments.mean), symmetrized(moments.cov + frame_cov_)};
 }
 
 template <class Motion, class Sensor, template <class> class Map>
@@ -732,21 +744,15 @@ auto FastSlam<Motion, Sensor, Map>::path_posterior() const -> PathPosterior {
   out.poses.resize(particles_.front().path.size());
   out.support.resize(out.poses.size());
   std::vector<double> w;
-  std::vector<Eigen::Matrix<double, X, 1>> d;
   const auto visit = [&](std::size_t j, std::span<const typename Path::WeightedPose> poses) {
     w.clear();
-    d.clear();
     std::size_t heaviest = 0;
     for (std::size_t i = 0; i < poses.size(); ++i) {
       w.push_back(poses[i].weight);
       if (poses[i].weight > poses[heaviest].weight) heaviest = i;
     }
-    const State& reference = poses[heaviest].pose->mean;
-    for (const auto& p : poses) d.push_back(Space::minus(p.pose->mean, reference));
-    const auto moments = mixture_moments<X>(w, [&](std::size_t i) { return d[i]; },
-                                            [&](std::size_t i) { return poses[i].pose->cov; });
     out.poses[j] = in_canonical_coordinates<Space>(
-        PoseEstimate{Space::plus(reference, moments.mean), symmetrized(moments.cov + frame_cov_)});
+        mixture_in_frame(w, heaviest, [&](std::size_t i) -> const PoseEstimate& { return *poses[i].pose; }));
     out.support[j] = 1.0 / std::inner_product(w.begin(), w.end(), w.begin(), 0.0);
   };
   Path::walk_back(paths, normalized_weights(particles_), visit);
