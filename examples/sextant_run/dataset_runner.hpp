@@ -57,6 +57,7 @@ template <class Dataset>
 std::vector<TableRow> run_dataset(const RunOptions& options, const std::string& name, const Dataset& data,
                                   const std::vector<BackendKind>& kinds, const RunnerConfig& config,
                                   const char* unit) {
+  print_warnings(data.implausible);
   print_dataset_header(name, data, unit);
   return run_dataset_rows(options, name, data, kinds, config, unit);
 }

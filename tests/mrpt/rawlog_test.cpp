@@ -342,6 +342,27 @@ TEST_F(WrittenRawlog, BadLogsGiveOneLineErrorsNamingFileAndProblem) {
     EXPECT_EQ(error_of(path).find('\n'), std::string::npos) << path;
 }
 
+TEST_F(WrittenRawlog, ASightingAtARangeAtOrBelowZeroIsDroppedAndListed) {
+  // MRPT's simul-landmarks adds Gaussian noise to the true range: a landmark next to the sensor now
+  // and then comes out at a negative range. The log is read; that sighting alone is dropped, named.
+  const auto path = write("near.rawlog", false, action(0.5, 0.0, 0.1), frame(bearing({{1, 2.0f}, {2, -0.03f}, {3, 1.0f}})),
+                          action(0.5, 0.0, 0.1), frame(bearing({{2, 0.0f}})));
+  const auto data = read_rawlog_2d(path);
+  ASSERT_EQ(data.steps.size(), 2u);
+  ASSERT_EQ(data.steps[0].observations.size(), 2u);
+  EXPECT_EQ(data.steps[0].observations[0].landmark_id, 1u);
+  EXPECT_EQ(data.steps[0].observations[1].landmark_id, 3u);
+  EXPECT_TRUE(data.steps[1].observations.empty());
+  EXPECT_EQ(data.implausible.count, 2u);
+  const auto warnings = data.implausible.warnings();
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_NE(warnings[0].find(path + ": entry 1: landmark 2: range -0.03 m is not positive: the sighting is dropped"),
+            std::string::npos)
+      << warnings[0];
+  EXPECT_NE(warnings[1].find("entry 3: landmark 2: range 0 m"), std::string::npos) << warnings[1];
+  EXPECT_EQ(std::get<RawlogDataset2D>(read_rawlog(path)).implausible.count, 2u);
+}
+
 TEST_F(WrittenRawlog, LandmarksWithoutIdsTakeTheirIdsFromTheGroundTruth) {
   // Two landmarks 1 m apart, seen from the origin and from 1 m further on: MRPT's landmarkID = -1.
   auto obs = [](float range, float yaw) {

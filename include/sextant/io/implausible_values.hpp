@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace sextant::io {
@@ -21,12 +22,16 @@ struct ImplausibleValues {
   /// Records `what` at `where` when |value| > limit.
   void check(double value, double limit, const std::string& where, const char* what, const char* unit) {
     if (!(std::abs(value) > limit)) return;
-    ++count;
-    if (listed.size() >= kListed) return;
     char text[160];
     std::snprintf(text, sizeof text, ": %s %.6g %s is beyond the plausible %.6g %s (used as given)", what, value, unit,
                   limit, unit);
-    listed.push_back(where + text);
+    record(where + text);
+  }
+
+  /// Records a line that says what was found and what the reader did with it.
+  void record(std::string line) {
+    ++count;
+    if (listed.size() < kListed) listed.push_back(std::move(line));
   }
 
   /// The lines a program prints: each listed value, then how many more there are.

@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <mrpt/io/CFileGZInputStream.h>
@@ -147,6 +148,8 @@ class RawlogParser {
   const SensorDescription& sensor() const { return sensor_; }
   /// Whether the landmarks carry ids (false: MRPT's landmarkID = -1 throughout).
   bool has_ids() const { return ids_.value_or(true); }
+  /// The readings dropped on the way (drop_non_positive_range), for warnings.
+  const io::ImplausibleValues& implausible() const { return implausible_; }
 
  private:
   [[noreturn]] void fail(const std::string& problem) const {
@@ -215,11 +218,23 @@ class RawlogParser {
       const std::string which = with_id ? "landmark " + std::to_string(m.landmarkID) : "a landmark without id";
       const Eigen::Vector3d z(m.range, m.yaw, m.pitch);
       if (!z.allFinite()) fail(which + ": measurement contains NaN or Inf");
-      if (!(z(0) > 0.0)) fail(which + ": range must be positive");
+      if (!(z(0) > 0.0)) {
+        drop_non_positive_range(which, z(0));
+        continue;
+      }
       const LandmarkId id = with_id ? static_cast<LandmarkId>(m.landmarkID) : io::kNoLandmarkId;
       if (with_id && !seen.insert(id).second) fail(which + " measured twice in one frame");
       step.sightings.push_back({id, z});
     }
+  }
+
+  /// A range sensor with Gaussian noise reports a landmark next to it at a range <= 0 now and then
+  /// (MRPT's simul-landmarks does, its noise added to the true range): a reading that no model here
+  /// can invert into a landmark, and a log that is otherwise sound. Dropped and listed (a warning).
+  void drop_non_positive_range(const std::string& which, double range) {
+    char text[96];
+    std::snprintf(text, sizeof text, ": range %.6g m is not positive: the sighting is dropped", range);
+    implausible_.record(path_ + ": entry " + std::to_string(entry_) + ": " + which + text);
   }
 
   /// A log gives every landmark an id (landmarkID >= 0) or none (-1, MRPT's "unknown"), not both.
@@ -252,6 +267,7 @@ class RawlogParser {
   std::optional<::mrpt::poses::CPose2D> last_odometry_;
   SensorDescription sensor_;
   std::optional<bool> ids_;  ///< whether the landmarks seen so far had ids
+  io::ImplausibleValues implausible_;
 };
 
 /// The noise standard deviation to use: the override if given, else the rawlog's (which must be > 0).
@@ -264,9 +280,6 @@ inline double noise_std(const std::optional<double>& override_value, double from
   return value;
 }
 
-inline io::LandmarkIds ids_of(const RawlogParser& parser) {
-  return parser.has_ids() ? io::LandmarkIds::measured : io::LandmarkIds::absent;
-}
 
 inline double step_dt(const std::vector<RawStep>& steps, std::size_t k) {
   const double previous = k == 0 ? 0.0 : steps[k - 1].time;
@@ -288,13 +301,22 @@ inline bool is_spatial(const std::vector<RawStep>& steps, const SensorDescriptio
   return sensor.mount(2) != 0.0 || !sensor.mount.tail<2>().isZero();
 }
 
+/// What a dataset says of the log beside its steps: where it came from, whether its landmarks carry
+/// ids, the readings the parser dropped.
+template <class Dataset>
+void describe_log(Dataset& out, const std::string& path, const RawlogParser& parser) {
+  out.path = path;
+  out.ids = parser.has_ids() ? io::LandmarkIds::measured : io::LandmarkIds::absent;
+  out.implausible = parser.implausible();
+}
+
 /// The parsed log as planar steps: (x, y, heading) odometry (3D odometry projected onto the
 /// plane), range and bearing; a nonzero pitch is an error.
-inline RawlogDataset2D to_planar(const std::string& path, const std::vector<RawStep>& raw, const SensorDescription& sensor,
-                                 io::LandmarkIds ids, const RawlogOptions& options) {
+inline RawlogDataset2D to_planar(const std::string& path, const std::vector<RawStep>& raw, const RawlogParser& parser,
+                                 const RawlogOptions& options) {
   RawlogDataset2D out;
-  out.path = path;
-  out.ids = ids;
+  describe_log(out, path, parser);
+  const SensorDescription& sensor = parser.sensor();
   out.sensor.sensor_pose << sensor.mount(0), sensor.mount(1), sensor.mount(3);
   const double sr = noise_std(options.std_range, sensor.std_range_yaw_pitch(0), path, "range");
   const double sy = noise_std(options.std_yaw, sensor.std_range_yaw_pitch(1), path, "yaw");
@@ -321,11 +343,11 @@ inline RawlogDataset2D to_planar(const std::string& path, const std::vector<RawS
 }
 
 /// The parsed log as spatial steps: 6D odometry, range, yaw and pitch; 2D odometry is an error.
-inline RawlogDataset3D to_spatial(const std::string& path, const std::vector<RawStep>& raw,
-                                  const SensorDescription& sensor, io::LandmarkIds ids, const RawlogOptions& options) {
+inline RawlogDataset3D to_spatial(const std::string& path, const std::vector<RawStep>& raw, const RawlogParser& parser,
+                                  const RawlogOptions& options) {
   RawlogDataset3D out;
-  out.path = path;
-  out.ids = ids;
+  describe_log(out, path, parser);
+  const SensorDescription& sensor = parser.sensor();
   out.sensor.sensor_pose = sensor.mount;
   const double sr = noise_std(options.std_range, sensor.std_range_yaw_pitch(0), path, "range");
   const double sy = noise_std(options.std_yaw, sensor.std_range_yaw_pitch(1), path, "yaw");
@@ -360,14 +382,14 @@ inline RawlogKind detect_rawlog_kind(const std::string& path, const RawlogOption
 inline RawlogDataset2D read_rawlog_2d(const std::string& path, const RawlogOptions& options = {}) {
   detail::RawlogParser parser(path);
   const auto raw = parser.parse(options);
-  return detail::to_planar(path, raw, parser.sensor(), detail::ids_of(parser), options);
+  return detail::to_planar(path, raw, parser, options);
 }
 
 /// Reads a spatial rawlog: 6D robot, 6D odometry, range, yaw and pitch. 2D odometry is an error.
 inline RawlogDataset3D read_rawlog_3d(const std::string& path, const RawlogOptions& options = {}) {
   detail::RawlogParser parser(path);
   const auto raw = parser.parse(options);
-  return detail::to_spatial(path, raw, parser.sensor(), detail::ids_of(parser), options);
+  return detail::to_spatial(path, raw, parser, options);
 }
 
 /// Reads a rawlog once as whichever it is, planar or spatial (see detect_rawlog_kind).
@@ -375,8 +397,8 @@ inline std::variant<RawlogDataset2D, RawlogDataset3D> read_rawlog(const std::str
                                                                   const RawlogOptions& options = {}) {
   detail::RawlogParser parser(path);
   const auto raw = parser.parse(options);
-  if (detail::is_spatial(raw, parser.sensor())) return detail::to_spatial(path, raw, parser.sensor(), detail::ids_of(parser), options);
-  return detail::to_planar(path, raw, parser.sensor(), detail::ids_of(parser), options);
+  if (detail::is_spatial(raw, parser.sensor())) return detail::to_spatial(path, raw, parser, options);
+  return detail::to_planar(path, raw, parser, options);
 }
 
 /// The ground-truth files beside a rawlog, if both exist: `<stem>_ground_truth.txt` (map) and
