@@ -235,7 +235,7 @@ class FastSlam {
   void commit(Transaction&& t);
   /// With options().keep_paths: each particle's path gains its pose after a predict (extend), or its
   /// last pose becomes the one the update drew (settle).
-  void extend_paths(Transaction& t) const;
+  void extend_paths(Transaction& t, const std::vector<PoseEstimate>& components) const;
   void settle_paths(Transaction& t) const;
 
   /// The particle after a draw from N(mean, cov): its sampled entries drawn, its tail kept Gaussian.
@@ -338,10 +338,14 @@ class FastSlam {
   std::vector<std::size_t> associate_in_particle(Particle& particle, State& mean, PoseMatrix& cov,
                                                  std::span<const Measurement> measurements, bool proposal) const;
   std::vector<std::size_t> normalize_and_resample(Transaction& t) const;
-  PoseEstimate cloud_estimate(const std::vector<Particle>& cloud, const std::vector<PendingMotion>& pending) const;
+  /// The weighted mixture of the particles' pose Gaussians (components: pose_components of the cloud).
+  PoseEstimate cloud_estimate(const std::vector<Particle>& cloud, const std::vector<PoseEstimate>& components) const;
   template <class Component>
   PoseEstimate mixture_in_frame(const std::vector<double>& w, std::size_t reference, Component&& component) const;
+  /// A particle's pose Gaussian: its proposal, or its pose moved by the pending motions (checked).
   PoseEstimate pose_component(const Particle& particle, const std::vector<PendingMotion>& pending) const;
+  std::vector<PoseEstimate> pose_components(const std::vector<Particle>& cloud,
+                                            const std::vector<PendingMotion>& pending) const;
   double point_support(const std::vector<Particle>& cloud, const std::vector<PendingMotion>& pending,
                        bool frame_fixed) const;
   static std::vector<double> normalized_weights(const std::vector<Particle>& particles);

@@ -90,9 +90,9 @@ void FastSlam<Motion, Sensor, Map>::commit(Transaction&& t) {
 }
 
 template <class Motion, class Sensor, template <class> class Map>
-void FastSlam<Motion, Sensor, Map>::extend_paths(Transaction& t) const {
+void FastSlam<Motion, Sensor, Map>::extend_paths(Transaction& t, const std::vector<PoseEstimate>& components) const {
   if (!options_.keep_paths) return;
-  for (auto& particle : t.particles) particle.path.push_back(pose_component(particle, t.pending));
+  for (std::size_t i = 0; i < t.particles.size(); ++i) t.particles[i].path.push_back(components[i]);
 }
 
 template <class Motion, class Sensor, template <class> class Map>
@@ -119,7 +119,7 @@ void FastSlam<Motion, Sensor, Map>::predict_without_map(const Control& u, double
   }
   t.estimate = PoseEstimate{p.x, total};
   t.support = std::numeric_limits<double>::infinity();
-  extend_paths(t);
+  if (options_.keep_paths) extend_paths(t, pose_components(t.particles, t.pending));
   commit(std::move(t));
 }
 
@@ -131,8 +131,9 @@ void FastSlam<Motion, Sensor, Map>::fix_frame_if_mapped(Transaction& t) const {
 }
 
 /// FastSLAM 1.0 samples now; 2.0 keeps the motion pending for update()'s proposal (a second predict
-/// in a row samples the first one plainly). Either way every particle's motion is checked here,
-/// and so is the cloud's pose estimate (it overflows when the particles spread over 1e154).
+/// in a row samples the first one plainly). Either way every particle's motion is checked here
+/// (pose_components), and so is the cloud's pose estimate (it overflows when the particles spread
+/// over 1e154).
 template <class Motion, class Sensor, template <class> class Map>
 void FastSlam<Motion, Sensor, Map>::predict(const Control& u, double dt) {
   require_finite(u, "control");
@@ -142,13 +143,11 @@ void FastSlam<Motion, Sensor, Map>::predict(const Control& u, double dt) {
   t.estimate.reset();
   apply_pending_motion_v1(t);
   t.pending.push_back({u, dt});
-  if (options_.version == FastSlamVersion::v1)
-    apply_pending_motion_v1(t);
-  else
-    for (const auto& particle : t.particles) checked_motion_prediction(motion_, particle.x, u, dt);
-  t.estimate = cloud_estimate(t.particles, t.pending);  // pose() after an accepted predict cannot throw
+  if (options_.version == FastSlamVersion::v1) apply_pending_motion_v1(t);
+  const auto components = pose_components(t.particles, t.pending);
+  t.estimate = cloud_estimate(t.particles, components);  // pose() after an accepted predict cannot throw
   t.support = point_support(t.particles, t.pending, t.frame_fixed);
-  extend_paths(t);
+  extend_paths(t, components);
   commit(std::move(t));
 }
 
@@ -580,7 +579,7 @@ std::vector<std::size_t> FastSlam<Motion, Sensor, Map>::normalize_and_resample(T
   for (const auto& p : particles) sum += std::exp(p.log_weight - max_log);
   const double log_total = max_log + std::log(sum);
   for (auto& p : particles) p.log_weight -= log_total;
-  t.estimate = cloud_estimate(particles, t.pending);
+  t.estimate = cloud_estimate(particles, pose_components(particles, t.pending));
   t.support = point_support(particles, t.pending, t.frame_fixed);
   const double n = static_cast<double>(particles.size());
   const auto w = normalized_weights(particles);
@@ -652,7 +651,8 @@ std::size_t FastSlam<Motion, Sensor, Map>::heaviest_particle(const std::vector<P
 /// given in the space's canonical coordinates (in_canonical_coordinates).
 template <class Motion, class Sensor, template <class> class Map>
 auto FastSlam<Motion, Sensor, Map>::pose() const -> PoseEstimate {
-  return in_canonical_coordinates<Space>(estimate_ ? *estimate_ : cloud_estimate(particles_, pending_));
+  if (estimate_) return in_canonical_coordinates<Space>(*estimate_);
+  return in_canonical_coordinates<Space>(cloud_estimate(particles_, pose_components(particles_, pending_)));
 }
 
 template <class Motion, class Sensor, template <class> class Map>
@@ -698,19 +698,26 @@ auto FastSlam<Motion, Sensor, Map>::pose_component(const Particle& particle, con
   if (pending.empty()) return {particle.drawn_from, particle.drawn_cov};
   PoseEstimate out{particle.x, particle.cov};
   for (const auto& motion : pending) {
-    const auto p = motion_.predict(out.mean, motion.u, motion.dt);
+    const auto p = checked_motion_prediction(motion_, out.mean, motion.u, motion.dt);
     out = {p.x, symmetrized(p.J_x_x * out.cov * p.J_x_x.transpose() + p.R)};
   }
   return out;
 }
 
 template <class Motion, class Sensor, template <class> class Map>
-auto FastSlam<Motion, Sensor, Map>::cloud_estimate(const std::vector<Particle>& cloud,
-                                                   const std::vector<PendingMotion>& pending) const -> PoseEstimate {
-  const auto w = normalized_weights(cloud);
+auto FastSlam<Motion, Sensor, Map>::pose_components(const std::vector<Particle>& cloud,
+                                                    const std::vector<PendingMotion>& pending) const
+    -> std::vector<PoseEstimate> {
   std::vector<PoseEstimate> components;
   components.reserve(cloud.size());
   for (const auto& particle : cloud) components.push_back(pose_component(particle, pending));
+  return components;
+}
+
+template <class Motion, class Sensor, template <class> class Map>
+auto FastSlam<Motion, Sensor, Map>::cloud_estimate(const std::vector<Particle>& cloud,
+                                                   const std::vector<PoseEstimate>& components) const -> PoseEstimate {
+  const auto w = normalized_weights(cloud);
   PoseEstimate out = mixture_in_frame(w, heaviest_particle(cloud), [&](std::size_t i) -> const PoseEstimate& {
     return components[i];
   });
