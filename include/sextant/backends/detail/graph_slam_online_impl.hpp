@@ -17,8 +17,10 @@ struct GraphSlam<Motion, Sensor>::OnlinePlan {
   Eigen::VectorXd theta_landmarks;
   Eigen::VectorXd g;
   std::vector<char> pose_moved, landmark_redo;
-  std::vector<typename Online::PoseFactor> factors;  ///< the old pose factors' sources, then the new ones
-  std::vector<std::size_t> factor_redo;
+  /// The sources of the pose factors this step adds, numbered on from the old ones (a source: which
+  /// factor and on which poses, no linearization yet).
+  std::vector<typename Online::PoseFactor> added_factors;
+  std::vector<std::size_t> factor_redo;  ///< old and added factors to linearize (again), by number
   std::vector<std::pair<std::size_t, typename Online::PoseFactor>> new_factors;
   std::vector<std::pair<std::size_t, typename Online::LandmarkLinearization>> new_landmarks;  ///< by slot
   Eigen::VectorXd delta_poses, delta_landmarks;
@@ -112,16 +114,16 @@ template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::plan_pose_factors(OnlinePlan& plan) const {
   const Online& on = online_;
   const std::size_t old_poses = on.theta.size();
-  plan.factors = on.pose_factors;
+  auto& added = plan.added_factors;
   if (old_poses == 0) {
-    plan.factors.push_back({Online::Source::prior, 0, {0}, {}, {}});
+    added.push_back({Online::Source::prior, 0, {0}, {}, {}});
     for (std::size_t f = 0; f < linear_factors_.size(); ++f)
-      plan.factors.push_back({Online::Source::marginal, f, linear_factors_[f].poses, {}, {}});
+      added.push_back({Online::Source::marginal, f, linear_factors_[f].poses, {}, {}});
   }
   for (std::size_t k = old_poses == 0 ? 0 : old_poses - 1; k + 1 < poses_.size(); ++k)
-    plan.factors.push_back({Online::Source::motion, k, {k, k + 1}, {}, {}});
-  std::vector<char> redo(plan.factors.size(), 0);
-  for (std::size_t f = on.pose_factors.size(); f < plan.factors.size(); ++f) redo[f] = 1;
+    added.push_back({Online::Source::motion, k, {k, k + 1}, {}, {}});
+  std::vector<char> redo(on.pose_factors.size() + added.size(), 0);
+  std::fill(redo.begin() + static_cast<std::ptrdiff_t>(on.pose_factors.size()), redo.end(), char{1});
   for (std::size_t p = 0; p < old_poses; ++p) {
     if (!plan.pose_moved[p]) continue;
     for (std::size_t f : on.factors_of_pose[p]) redo[f] = 1;
@@ -139,9 +141,13 @@ void GraphSlam<Motion, Sensor>::stage_online_factors(OnlinePlan& plan) {
   plan.g.conservativeResize(X * static_cast<Eigen::Index>(poses_.size()));
   plan.g.tail(X * static_cast<Eigen::Index>(poses_.size() - on.theta.size())).setZero();
   for (std::size_t p = on.theta.size(); p < poses_.size(); ++p) on.S.append_row();
+  const std::size_t old_factors = on.pose_factors.size();
+  auto source = [&](std::size_t f) -> const typename Online::PoseFactor& {
+    return f < old_factors ? on.pose_factors[f] : plan.added_factors[f - old_factors];
+  };
   for (std::size_t f : plan.factor_redo) {
-    if (f < on.pose_factors.size()) Online::add(on.S, plan.g, on.pose_factors[f], -1.0);
-    auto lin = linearize_pose_factor_online(plan.factors[f], plan);
+    if (f < old_factors) Online::add(on.S, plan.g, on.pose_factors[f], -1.0);
+    auto lin = linearize_pose_factor_online(source(f), plan);
     Online::add(on.S, plan.g, lin, +1.0);
     plan.new_factors.emplace_back(f, std::move(lin));
   }
@@ -188,7 +194,7 @@ void GraphSlam<Motion, Sensor>::commit_online_step(OnlinePlan& plan) {
   on.theta = std::move(plan.theta);
   on.theta_landmarks = std::move(plan.theta_landmarks);
   on.g = std::move(plan.g);
-  on.pose_factors.resize(plan.factors.size());
+  on.pose_factors.resize(old_factors + plan.added_factors.size());
   on.factors_of_pose.resize(poses_.size());
   on.landmarks_of_pose.resize(poses_.size());
   for (auto& [f, lin] : plan.new_factors) {
