@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
+#include <numbers>
+#include <random>
 
 #include "sextant/backends/graph_slam.hpp"
 #include "sextant/eval/runner.hpp"
@@ -48,6 +50,42 @@ TEST(GraphSlamOnline, EqualsTheBatchOptimumAfterEveryFrameOnALinearProblem) {
   }
   EXPECT_LT(worst_mean, 1e-9);
   EXPECT_LT(worst_cov, 1e-9);
+}
+
+/// A robot that drives the same loop twice, seeing on the second lap the landmarks of the first: from
+/// the first re-observation on, each row of the reduced system reaches a lap back and the dense
+/// refactorization from there passes ProfileCholesky's check, so the steps go sparse (a fill-reducing
+/// order). Linear, so the online estimate must still be the batch optimum, and pose() its marginal.
+TEST(GraphSlamOnline, ALoopThatWidensTheEnvelopeGoesSparseAndStaysTheBatchOptimum) {
+  constexpr int kLap = 210;  // 2 x 211 = 422 dimensions back at the first closure: > 2e7 flops dense
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::vector<Step<Eigen::Vector2d, Eigen::Vector2d>> steps;
+  for (int k = 0; k < 2 * kLap; ++k) {
+    const double heading = 2.0 * std::numbers::pi * (k % kLap) / kLap;
+    Step<Eigen::Vector2d, Eigen::Vector2d> step{Eigen::Vector2d(1.0, heading), 0.5, {}};
+    for (int j = (k % kLap) / 3; j <= (k % kLap) / 3 + 1; ++j)
+      step.observations.push_back({static_cast<LandmarkId>(j), Eigen::Vector2d(unit(rng), unit(rng))});
+    steps.push_back(step);
+  }
+  Graph online{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.incremental = true}};
+  std::size_t sparse = 0, first_sparse = 0;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    online.predict(steps[k].control, steps[k].dt);
+    online.update(steps[k].observations);
+    if (online.last_online_step().sparse && sparse++ == 0) first_sparse = k;
+  }
+#ifdef SEXTANT_HAS_CHOLMOD
+  EXPECT_EQ(first_sparse, static_cast<std::size_t>(kLap));  // the first frame that closes the loop
+  EXPECT_EQ(sparse, static_cast<std::size_t>(kLap));        // and every frame after it
+#else
+  EXPECT_EQ(sparse, 0u);  // without CHOLMOD no analysis predicts the sparse flops: always dense
+#endif
+  Graph batch{test::kLinearMotion, test::kLinearSensor, test::kLinearPrior, {.max_iterations = 1}};
+  eval::run(batch, steps);
+  batch.optimize();
+  EXPECT_LT(largest_difference(online, batch), 1e-9);
+  EXPECT_LT((online.pose().cov - batch.trajectory().back().cov).cwiseAbs().maxCoeff(), 1e-9);
 }
 
 /// The ship is nonlinear (heading in the motion, range and bearing): the online estimate, relinearized

@@ -122,5 +122,80 @@ TEST(ProfileCholesky, MemoryKeptBetweenFactorizationsIsNotPartOfTheResult) {
   EXPECT_EQ(S.solve(b), before);
 }
 
+/// A robot that comes back to where it started: a chain of rows, and from row 140 on every fifth
+/// row also coupled to one of the first five. The dense refactorization from the oldest touched row
+/// is then the whole matrix, mostly zero blocks; the sparse one in a fill-reducing order is cheaper
+/// and taken, and from then on (a dense step would start at row 0); every solve and the last block
+/// of the inverse equal a dense LLT's of the same matrix.
+TEST(ProfileCholesky, ALoopBackToTheStartIsFactorizedSparseAndSolvesAsTheDenseFactor) {
+  std::mt19937 rng(11);
+  Profile S;
+  for (std::size_t n = 0; n < 165; ++n) {
+    S.append_row();
+    S.add(n, n, 10.0 * Block::Identity());
+    if (n > 0) S.add(n, n - 1, random_block(rng));
+    const bool loop = n >= 140 && n % 5 == 0;
+    if (loop) {
+      S.add(n, n % 25 / 5, random_block(rng));
+      S.add(n % 25 / 5, n % 25 / 5, Block::Identity());
+    }
+    S.factorize();
+#ifdef SEXTANT_HAS_CHOLMOD
+    EXPECT_EQ(S.factorized_sparse(), n >= 140) << n;  // the loops reach 140 rows back: > 2e7 flops dense
+#else
+    EXPECT_FALSE(S.factorized_sparse()) << n;  // no analysis to predict the sparse flops: always dense
+#endif
+    const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(3 * static_cast<Eigen::Index>(n + 1), -1.0, 2.0);
+    const Eigen::VectorXd staged = S.solve(b);
+    const Block staged_last = S.last_inverse_block();
+    S.commit();
+    EXPECT_EQ(S.solve(b), staged) << n;  // the committed factor is the staged one
+    if (n < 138 || (!loop && n % 4 != 0)) continue;  // the dense reference is O(n^3)
+    const Eigen::MatrixXd dense = S.dense();
+    const Eigen::LLT<Eigen::MatrixXd> llt(dense);
+    EXPECT_LT((staged - llt.solve(b)).cwiseAbs().maxCoeff(), 1e-12) << n;
+    Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(dense.rows(), 3);
+    unit.bottomRows(3).setIdentity();
+    EXPECT_LT((staged_last - llt.solve(unit).bottomRows(3)).cwiseAbs().maxCoeff(), 1e-12) << n;
+  }
+}
+
+/// After a sparse step the matrix and both factors survive what the dense ones do: a copy solves
+/// to the same bits, an indefinite change throws and leaves the solve as it was, a discarded one too.
+TEST(ProfileCholesky, ASparseStepKeepsTheStrongGuaranteeAndCopies) {
+#ifndef SEXTANT_HAS_CHOLMOD
+  GTEST_SKIP() << "without CHOLMOD no step goes sparse";
+#endif
+  std::mt19937 rng(13);
+  Profile S = chain(160, 10.0, rng);
+  S.factorize();
+  S.commit();
+  S.append_row();
+  S.add(160, 160, 10.0 * Block::Identity());
+  S.add(160, 159, random_block(rng));
+  S.add(160, 1, random_block(rng));
+  S.factorize();
+  ASSERT_TRUE(S.factorized_sparse());
+  S.commit();
+  ASSERT_TRUE(S.factorized_sparse());
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(3 * 161, -1.0, 2.0);
+  const Eigen::VectorXd before = S.solve(b);
+  const Profile copy = S;
+  EXPECT_EQ(copy.solve(b), before);
+  EXPECT_EQ(copy.last_inverse_block(), S.last_inverse_block());
+  S.append_row();
+  S.add(161, 161, Block::Identity());
+  S.add(161, 0, random_block(rng));
+  S.add(100, 100, -100.0 * Block::Identity());
+  EXPECT_THROW(S.factorize(), numerical_error);
+  EXPECT_EQ(S.rows(), 161u);
+  EXPECT_EQ(S.solve(b), before);
+  S.add(100, 100, Block::Identity());
+  S.factorize();
+  EXPECT_NE(S.solve(b), before);
+  S.discard();
+  EXPECT_EQ(S.solve(b), before);
+}
+
 }  // namespace
 }  // namespace sextant

@@ -11,6 +11,15 @@
 /// precede (docs/derivations/incremental_graph_slam.md). The trailing block is factorized densely
 /// (Eigen's blocked LLT), in place in a MatrixWorkspace kept from one call to the next.
 ///
+/// Where rows reach far back (a robot that loops through the same places: each row's envelope then
+/// spans the loops between), the trailing block is most of the matrix and mostly zero blocks, and
+/// a sparse factorization of the whole matrix in a fill-reducing order (core/sparse_cholesky.hpp,
+/// CHOLMOD) costs a fraction of it. factorize() weighs the two by their flops once the dense one
+/// passes kSparseCheckFlops and takes the sparse one where it is far cheaper. A sparse step leaves
+/// no profile factor: the next steps weigh a dense refactorization from row 0 against a sparse one,
+/// so once the envelope has grown wide they stay sparse (a whole factorization a step, in the order
+/// that keeps its fill small).
+///
 /// Changes are a transaction: add() and append_row() stage copies of the rows they touch,
 /// factorize() computes the staged matrix's factor (solve() and last_inverse_block() then use it),
 /// commit() keeps both, discard() drops them (matrix and factor exactly as before). factorize()
@@ -21,12 +30,14 @@
 #include <algorithm>
 #include <cstddef>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "sextant/core/error.hpp"
 #include "sextant/core/matrix_workspace.hpp"
+#include "sextant/core/sparse_cholesky.hpp"
 
 namespace sextant {
 
@@ -36,12 +47,49 @@ class ProfileCholesky {
   using Block = Eigen::Matrix<double, B, B>;
   using Vector = Eigen::VectorXd;
 
+  ProfileCholesky() = default;
+  /// A copy has its own sparse factors, factorized again from its matrix (CHOLMOD's cannot be copied).
+  ProfileCholesky(const ProfileCholesky& other)
+      : matrix_(other.matrix_),
+        factor_(other.factor_),
+        staged_index_(other.staged_index_),
+        staged_rows_(other.staged_rows_),
+        staged_ids_(other.staged_ids_),
+        staged_factor_(other.staged_factor_),
+        refactorized_from_(other.refactorized_from_),
+        next_sparse_check_(other.next_sparse_check_),
+        staged_sparse_check_(other.staged_sparse_check_),
+        factorized_(other.factorized_),
+        staged_count_(other.staged_count_),
+        first_changed_(other.first_changed_) {
+    if (other.committed_sparse_) committed_sparse_ = sparse_factor_of(lower_triangle(matrix_.size(), false));
+    if (other.staged_sparse_) staged_sparse_ = sparse_factor_of(lower_triangle(staged_count_, true));
+  }
+  ProfileCholesky& operator=(const ProfileCholesky& other) {
+    if (this != &other) *this = ProfileCholesky(other);
+    return *this;
+  }
+  ProfileCholesky(ProfileCholesky&&) noexcept = default;
+  ProfileCholesky& operator=(ProfileCholesky&&) noexcept = default;
+  ~ProfileCholesky() = default;
+
   /// Block rows of the committed matrix.
   std::size_t rows() const { return matrix_.size(); }
   /// Block rows including the staged ones.
   std::size_t staged_rows() const { return staged_count_; }
   /// The first block row the staged changes touch (rows() when nothing is staged).
   std::size_t first_changed() const { return first_changed_; }
+  /// Whether the last factorize() took the sparse factorization of the whole matrix.
+  bool factorized_sparse() const { return factorized_ ? staged_sparse_ != nullptr : committed_sparse_ != nullptr; }
+
+  /// Past this many flops of the trailing dense factorization (a few milliseconds), factorize()
+  /// asks a sparse one what it would cost, and takes it where it is kSparseAdvantage times cheaper:
+  /// CHOLMOD's kernels, the assembly and the analysis cost more a flop than the dense blocked LLT
+  /// in place (on the thesis-scale globe, whose coupling is dense, a sparse factorization predicted
+  /// 5-15% cheaper took 20% longer). A check that finds no such saving is not made again until the
+  /// dense cost has doubled, so that a dense problem pays for a few analyses, not one a frame.
+  static constexpr double kSparseCheckFlops = 2e7;
+  static constexpr double kSparseAdvantage = 10.0;
 
   /// Stages a new block row (zero; it must get a positive definite diagonal before factorize()).
   void append_row() {
@@ -65,7 +113,10 @@ class ProfileCholesky {
   /// numerical_error, and discards, if it is not positive definite.
   void factorize() {
     try {
-      staged_factor_ = factorized_trailing_rows();
+      refactorized_from_ = first_refactorized_row();
+      const double dense = trailing_flops(refactorized_from_);
+      if (!(dense > next_sparse_check_) || !factorize_sparse_if_cheaper(dense))
+        staged_factor_ = factorized_trailing_rows();
       factorized_ = true;
     } catch (...) {
       discard();
@@ -78,8 +129,14 @@ class ProfileCholesky {
     if (!factorized_) throw std::logic_error("ProfileCholesky::commit before factorize");
     matrix_.resize(staged_count_);
     for (std::size_t k = 0; k < staged_ids_.size(); ++k) matrix_[staged_ids_[k]] = std::move(staged_rows_[k]);
-    factor_.resize(first_changed_);
-    for (auto& row : staged_factor_) factor_.push_back(std::move(row));
+    if (staged_sparse_) {
+      factor_.clear();  // a later dense step refactorizes from row 0 (first_refactorized_row)
+    } else {
+      factor_.resize(refactorized_from_);
+      for (auto& row : staged_factor_) factor_.push_back(std::move(row));
+    }
+    committed_sparse_ = std::move(staged_sparse_);
+    next_sparse_check_ = staged_sparse_check_;
     discard();
   }
 
@@ -91,6 +148,8 @@ class ProfileCholesky {
     staged_rows_.clear();
     staged_ids_.clear();
     staged_factor_.clear();
+    staged_sparse_.reset();
+    staged_sparse_check_ = next_sparse_check_;
     factorized_ = false;
     staged_count_ = matrix_.size();
     first_changed_ = matrix_.size();
@@ -99,6 +158,7 @@ class ProfileCholesky {
   /// x with S x = b (the staged factor after factorize(), else the committed one), by one forward
   /// and one backward substitution.
   Vector solve(const Vector& b) const {
+    if (const SparseCholesky* sparse = sparse_factor()) return sparse->solve(b);
     const std::size_t n = factor_rows();
     Vector y(b.size());
     for (std::size_t i = 0; i < n; ++i) {
@@ -121,6 +181,11 @@ class ProfileCholesky {
 
   /// The block of S^-1 at the last row (the factor solve() uses): (L_nn L_nn^T)^-1, since L^-1 is lower triangular.
   Block last_inverse_block() const {
+    if (const SparseCholesky* sparse = sparse_factor()) {
+      Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(B * static_cast<Eigen::Index>(factor_rows()), B);
+      unit.bottomRows(B).setIdentity();
+      return sparse->solve(unit).bottomRows(B);
+    }
     const Block L = diagonal(factor_row(factor_rows() - 1));
     const Block L_inv = L.template triangularView<Eigen::Lower>().solve(Block::Identity());
     return L_inv.transpose() * L_inv;
@@ -148,9 +213,71 @@ class ProfileCholesky {
 
   static Block diagonal(const Row& row) { return row.blocks.template rightCols<B>(); }
 
-  std::size_t factor_rows() const { return factorized_ ? staged_count_ : factor_.size(); }
+  std::size_t factor_rows() const {
+    return factorized_ ? staged_count_ : committed_sparse_ ? matrix_.size() : factor_.size();
+  }
   const Row& factor_row(std::size_t i) const {
-    return factorized_ && i >= first_changed_ ? staged_factor_[i - first_changed_] : factor_[i];
+    return factorized_ && i >= refactorized_from_ ? staged_factor_[i - refactorized_from_] : factor_[i];
+  }
+  /// The sparse factor solve() uses: the staged one after a sparse factorize(), else the committed
+  /// one when the last committed step was sparse; null when it is the profile factor.
+  const SparseCholesky* sparse_factor() const {
+    return factorized_ ? staged_sparse_.get() : committed_sparse_.get();
+  }
+
+  /// Where the dense refactorization starts: the first changed row, or row 0 after a sparse step
+  /// (which leaves no profile factor).
+  std::size_t first_refactorized_row() const { return factor_.size() == matrix_.size() ? first_changed_ : 0; }
+
+  /// The flops of factorized_trailing_rows() from row e: m^3 / 3 for the trailing block of m
+  /// columns, m^2 w for its update with the w columns of the kept factor rows reach.
+  double trailing_flops(std::size_t e) const {
+    std::size_t reach = e;
+    for (std::size_t i = e; i < staged_count_; ++i) reach = std::min(reach, matrix_row(i).first);
+    const double m = B * static_cast<double>(staged_count_ - e), w = B * static_cast<double>(e - reach);
+    return m * m * m / 3.0 + m * m * w;
+  }
+
+  /// The staged matrix factorized as one sparse matrix (CHOLMOD's fill-reducing order) when its
+  /// analysis predicts a tenth of `dense`'s flops or less (kSparseAdvantage); false, and nothing
+  /// factorized, otherwise (and always without CHOLMOD, whose analysis alone predicts them).
+  bool factorize_sparse_if_cheaper(double dense) {
+    const Eigen::SparseMatrix<double> S = lower_triangle(staged_count_, true);
+    auto sparse = std::make_unique<SparseCholesky>(SparseCholesky::Factorization::by_fill);
+    if (!(kSparseAdvantage * sparse->predicted_flops(S) < dense)) {
+      staged_sparse_check_ = 2.0 * dense;  // kept by commit(), as the factor is
+      return false;
+    }
+    sparse->factorize(S);  // on the analysis predicted_flops made
+    staged_sparse_ = std::move(sparse);
+    return true;
+  }
+
+  /// A copy's sparse factor (the copy constructor's).
+  static std::unique_ptr<SparseCholesky> sparse_factor_of(const Eigen::SparseMatrix<double>& S) {
+    auto sparse = std::make_unique<SparseCholesky>(SparseCholesky::Factorization::by_fill);
+    sparse->factorize(S);
+    return sparse;
+  }
+
+  /// The lower triangle of the first `rows` block rows (of the staged matrix, or of the committed
+  /// one), its blocks that are not zero.
+  Eigen::SparseMatrix<double> lower_triangle(std::size_t rows, bool staged) const {
+    std::vector<Eigen::Triplet<double>> entries;
+    for (std::size_t i = 0; i < rows; ++i) {
+      const Row& row = staged ? matrix_row(i) : matrix_[i];
+      for (std::size_t j = row.first; j <= i; ++j) {
+        const auto block = row.blocks.template middleCols<B>(B * static_cast<Eigen::Index>(j - row.first));
+        if (j < i && block.isZero(0.0)) continue;
+        for (int c = 0; c < B; ++c)
+          for (int r = j < i ? 0 : c; r < B; ++r)
+            entries.emplace_back(B * static_cast<int>(i) + r, B * static_cast<int>(j) + c, block(r, c));
+      }
+    }
+    const Eigen::Index n = B * static_cast<Eigen::Index>(rows);
+    Eigen::SparseMatrix<double> S(n, n);
+    S.setFromTriplets(entries.begin(), entries.end());
+    return S;
   }
 
   Row& staged_row(std::size_t i) {
@@ -178,7 +305,7 @@ class ProfileCholesky {
   /// factorized in place in memory kept from one call to the next (a dense block allocated, zeroed
   /// and copied afresh each frame cost more than its factorization on a host slow to hand out pages).
   std::vector<Row> factorized_trailing_rows() {
-    const std::size_t e = first_changed_, n = staged_count_;
+    const std::size_t e = refactorized_from_, n = staged_count_;
     std::size_t reach = e;  // the oldest column a trailing row of the factor keeps below e
     for (std::size_t i = e; i < n; ++i) reach = std::min(reach, matrix_row(i).first);
     const Eigen::Index m = B * static_cast<Eigen::Index>(n - e), below = B * static_cast<Eigen::Index>(e - reach);
@@ -200,7 +327,7 @@ class ProfileCholesky {
   /// Block row i of the trailing block T's lower triangle (S_i from column e on, zero left of its
   /// envelope) and of `kept` (the committed factor's last kept.cols() columns before e, unchanged).
   void write_trailing_row(std::size_t i, Eigen::Ref<Eigen::MatrixXd> T, Eigen::Ref<Eigen::MatrixXd> kept) const {
-    const std::size_t e = first_changed_;
+    const std::size_t e = refactorized_from_;
     const Row& row = matrix_row(i);
     const Eigen::Index at = B * static_cast<Eigen::Index>(i - e);
     const std::size_t from = std::max(row.first, e);
@@ -216,7 +343,7 @@ class ProfileCholesky {
   /// Factor row i (i >= e): the unchanged columns before e, then row i - e of the trailing factor
   /// (lower triangle of T, the diagonal block's upper part zero).
   Row factor_row_from(std::size_t i, const Eigen::Ref<const Eigen::MatrixXd>& T) const {
-    const std::size_t e = first_changed_;
+    const std::size_t e = refactorized_from_;
     const Row& row = matrix_row(i);
     Row r{row.first, Eigen::Matrix<double, B, Eigen::Dynamic>(B, row.blocks.cols())};
     const std::size_t from = std::max(row.first, e);
@@ -232,8 +359,13 @@ class ProfileCholesky {
   std::vector<long> staged_index_;  ///< per row: its position in staged_rows_, -1 if not staged
   std::vector<Row> staged_rows_;    ///< copies of the rows the staged changes touch, and new rows
   std::vector<std::size_t> staged_ids_;  ///< the row of each staged copy
-  std::vector<Row> staged_factor_;  ///< rows first_changed_ .. of the staged matrix's factor
+  std::vector<Row> staged_factor_;  ///< rows refactorized_from_ .. of the staged matrix's factor
+  std::unique_ptr<SparseCholesky> staged_sparse_;     ///< the staged matrix's factor when factorize() went sparse
+  std::unique_ptr<SparseCholesky> committed_sparse_;  ///< the committed matrix's, when its step went sparse
   MatrixWorkspace trailing_, kept_;  ///< factorize()'s dense blocks, kept between calls (scratch)
+  std::size_t refactorized_from_ = 0;  ///< the first row of staged_factor_ (first_refactorized_row())
+  double next_sparse_check_ = kSparseCheckFlops;  ///< dense flops past which factorize() weighs a sparse step
+  double staged_sparse_check_ = kSparseCheckFlops;  ///< the staged step's, kept by commit()
   bool factorized_ = false;
   std::size_t staged_count_ = 0;
   std::size_t first_changed_ = 0;

@@ -9,6 +9,7 @@
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <limits>
 #include <memory>
 #include <vector>
 #ifdef SEXTANT_HAS_CHOLMOD
@@ -40,22 +41,19 @@ class SparseCholesky {
   /// Factorizes A (symmetric, both triangles or the lower one stored, compressed); analyses the
   /// pattern only when it differs from the last one. Throws numerical_error if A is not PD.
   void factorize(const SparseMatrix& A) {
-    if (A.rows() == 0 || A.nonZeros() == 0)  // CHOLMOD cannot analyse a matrix without entries
-      throw numerical_error("information matrix is empty or zero (not positive definite)");
-    if (!impl_ || !same_pattern(A)) {
-      impl_ = std::make_unique<Impl>(factorization_);
-      if (!impl_->analyze(A)) {
-        impl_.reset();
-        throw numerical_error("the sparse Cholesky analysis of the information matrix failed");
-      }
-      outer_.assign(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1);
-      inner_.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
-      ++analyses_;
-    }
+    analyze(A);
     if (!impl_->factorize(A)) {
       impl_.reset();
       throw numerical_error("information matrix is not positive definite (sparse Cholesky failed)");
     }
+  }
+
+  /// The flops of factorizing a matrix of A's pattern, as the symbolic analysis (made here when the
+  /// pattern differs from the last one; factorize(A) then reuses it) predicts them: CHOLMOD's count
+  /// for LL^T in its fill-reducing order. NaN without CHOLMOD (Eigen's simplicial LL^T does not say).
+  double predicted_flops(const SparseMatrix& A) {
+    analyze(A);
+    return impl_->flops();
   }
 
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const { return impl_->solve(b); }
@@ -115,11 +113,33 @@ class SparseCholesky {
       by_fill.factorize(A);
       return by_fill.info() == Eigen::Success;
     }
+    double flops() {
+#ifdef SEXTANT_HAS_CHOLMOD
+      return kind == Factorization::supernodal ? supernodal.cholmod().fl : by_fill.cholmod().fl;
+#else
+      return std::numeric_limits<double>::quiet_NaN();
+#endif
+    }
     template <class Rhs>
     Rhs solve(const Rhs& b) const {
       return kind == Factorization::supernodal ? Rhs(supernodal.solve(b)) : Rhs(by_fill.solve(b));
     }
   };
+
+  /// The symbolic analysis of A's pattern, unless the last one was of the same pattern.
+  void analyze(const SparseMatrix& A) {
+    if (A.rows() == 0 || A.nonZeros() == 0)  // CHOLMOD cannot analyse a matrix without entries
+      throw numerical_error("information matrix is empty or zero (not positive definite)");
+    if (impl_ && same_pattern(A)) return;
+    impl_ = std::make_unique<Impl>(factorization_);
+    if (!impl_->analyze(A)) {
+      impl_.reset();
+      throw numerical_error("the sparse Cholesky analysis of the information matrix failed");
+    }
+    outer_.assign(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1);
+    inner_.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+    ++analyses_;
+  }
 
   bool same_pattern(const SparseMatrix& A) const {
     return A.outerSize() + 1 == static_cast<Eigen::Index>(outer_.size()) &&

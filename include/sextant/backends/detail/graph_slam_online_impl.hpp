@@ -256,6 +256,7 @@ void GraphSlam<Motion, Sensor>::step_online(const std::vector<std::size_t>& touc
     stage_online_factors(plan);
     plan.summary.first_row = online_.S.first_changed();
     online_.S.factorize();
+    plan.summary.sparse = online_.S.factorized_sparse();
     plan_estimate(plan, online_.S.solve(plan.g));
   } catch (...) {
     online_.S.discard();

@@ -22,6 +22,7 @@ struct OnlineStepSummary {
   std::size_t relinearized_poses = 0;      ///< poses whose step exceeded the threshold
   std::size_t relinearized_landmarks = 0;  ///< landmarks whose step exceeded the threshold
   std::size_t linearized_landmarks = 0;    ///< landmarks whose factors were linearized again (new, seen, or moved)
+  bool sparse = false;  ///< S was factorized whole in a fill-reducing order, not from first_row on (ProfileCholesky)
 };
 
 template <int X, int M, class State>
