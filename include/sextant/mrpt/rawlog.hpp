@@ -229,8 +229,8 @@ class RawlogParser {
   }
 
   /// A range sensor with Gaussian noise reports a landmark next to it at a range <= 0 now and then
-  /// (MRPT's simul-landmarks does, its noise added to the true range): a reading that no model here
-  /// can invert into a landmark, and a log that is otherwise sound. Dropped and listed (a warning).
+  /// (MRPT's simul-landmarks writes 0 where its noise takes the true range below zero): a reading no
+  /// model here can invert into a landmark, in a log that is otherwise sound. Dropped and listed.
   void drop_non_positive_range(const std::string& which, double range) {
     char text[96];
     std::snprintf(text, sizeof text, ": range %.6g m is not positive: the sighting is dropped", range);
