@@ -7,6 +7,8 @@
 // running Ceres to the stationary point), -1 if it stops before.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <sextant/sextant.hpp>
 
@@ -181,6 +183,34 @@ void BM_CityTrees_CeresSparseNormalCholesky(benchmark::State& state) {
     solve_with_ceres<3>(state, ceres::SPARSE_NORMAL_CHOLESKY, build_city_trees_peer, city_trees_optimum());
 }
 
+/// GraphSLAM's online mode (one Gauss-Newton step a frame) over the whole ship, beside
+/// BM_Ship_GraphSlam's batch optimize() of the same steps: the ship closes its loop after 1200 steps,
+/// so its last frames reach back to the first poses (ProfileCholesky's sparse steps, counted).
+/// Counters: the last 100 frames' mean and the largest frame, in ms.
+void BM_Ship_GraphOnline(benchmark::State& state) {
+  std::size_t sparse = 0;
+  double last_100 = 0.0, largest = 0.0;
+  for (auto _ : state) {
+    ShipGraph graph{ship().motion, ship().sensor, ship().prior, {.incremental = true}};
+    sparse = 0;
+    last_100 = largest = 0.0;
+    const auto& steps = ship().steps;
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+      const auto start = std::chrono::steady_clock::now();
+      graph.predict(steps[k].control, steps[k].dt);
+      graph.update(steps[k].observations);
+      const double ms = 1e3 * seconds_since(start);
+      sparse += graph.last_online_step().sparse;
+      largest = std::max(largest, ms);
+      if (k + 100 >= steps.size()) last_100 += ms / 100.0;
+    }
+    benchmark::DoNotOptimize(graph.pose());
+  }
+  state.counters["sparse_steps"] = static_cast<double>(sparse);
+  state.counters["last_100_ms"] = last_100;
+  state.counters["largest_ms"] = largest;
+}
+
 /// A GraphSLAM run that asks for pose() after every step (what eval::run does): total time for
 /// K steps must grow linearly in K (pose() is O(1); docs/benchmarks.md).
 void BM_GraphSlamRunWithPoseEveryStep(benchmark::State& state) {
@@ -202,6 +232,7 @@ void BM_GraphSlamRunWithPoseEveryStep(benchmark::State& state) {
 
 BENCHMARK(BM_Ship_GraphSlam)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Ship_GraphSlamLandmarkSchur)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Ship_GraphOnline)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Ship_CeresSparseSchur)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Ship_CeresSparseNormalCholesky)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CityTrees_GraphSlam)->Unit(benchmark::kMillisecond);
