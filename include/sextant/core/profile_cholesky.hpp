@@ -114,9 +114,10 @@ class ProfileCholesky {
   void factorize() {
     try {
       refactorized_from_ = first_refactorized_row();
-      const double dense = trailing_flops(refactorized_from_);
+      const std::size_t reach = trailing_reach(refactorized_from_);
+      const double dense = trailing_flops(refactorized_from_, reach);
       if (!(dense > next_sparse_check_) || !factorize_sparse_if_cheaper(dense))
-        staged_factor_ = factorized_trailing_rows();
+        staged_factor_ = factorized_trailing_rows(reach);
       factorized_ = true;
     } catch (...) {
       discard();
@@ -227,13 +228,19 @@ class ProfileCholesky {
 
   /// Where the dense refactorization starts: the first changed row, or row 0 after a sparse step
   /// (which leaves no profile factor).
-  std::size_t first_refactorized_row() const { return factor_.size() == matrix_.size() ? first_changed_ : 0; }
+  std::size_t first_refactorized_row() const { return committed_sparse_ ? 0 : first_changed_; }
 
-  /// The flops of factorized_trailing_rows() from row e: m^3 / 3 for the trailing block of m
-  /// columns, m^2 w for its update with the w columns of the kept factor rows reach.
-  double trailing_flops(std::size_t e) const {
+  /// The oldest column a trailing row (e and after) reaches: the kept factor's columns reach .. e - 1
+  /// update the trailing block.
+  std::size_t trailing_reach(std::size_t e) const {
     std::size_t reach = e;
     for (std::size_t i = e; i < staged_count_; ++i) reach = std::min(reach, matrix_row(i).first);
+    return reach;
+  }
+
+  /// The flops of factorized_trailing_rows() from row e: m^3 / 3 for the trailing block of m
+  /// columns, m^2 w for its update with the w columns of the kept factor from `reach` to e.
+  double trailing_flops(std::size_t e, std::size_t reach) const {
     const double m = B * static_cast<double>(staged_count_ - e), w = B * static_cast<double>(e - reach);
     return m * m * m / 3.0 + m * m * w;
   }
@@ -304,10 +311,9 @@ class ProfileCholesky {
   /// The factor's rows e .. n - 1 of the staged matrix: chol(S[e:, e:] - L[e:, :e] L[e:, :e]^T),
   /// factorized in place in memory kept from one call to the next (a dense block allocated, zeroed
   /// and copied afresh each frame cost more than its factorization on a host slow to hand out pages).
-  std::vector<Row> factorized_trailing_rows() {
+  /// `reach`: trailing_reach(e), which factorize() has computed for the cost already.
+  std::vector<Row> factorized_trailing_rows(std::size_t reach) {
     const std::size_t e = refactorized_from_, n = staged_count_;
-    std::size_t reach = e;  // the oldest column a trailing row of the factor keeps below e
-    for (std::size_t i = e; i < n; ++i) reach = std::min(reach, matrix_row(i).first);
     const Eigen::Index m = B * static_cast<Eigen::Index>(n - e), below = B * static_cast<Eigen::Index>(e - reach);
     auto T = trailing_.view(m);
     auto kept = kept_.view(m, below);
