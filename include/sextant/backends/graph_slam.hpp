@@ -252,15 +252,15 @@ class GraphSlam {
   void add_lag_measurements(LagSys& sys, const LagEstimate& at, std::size_t slot, std::size_t from,
                                std::size_t to) const;
   void add_retired_prior(LagSys& sys, const LagEstimate& at, std::size_t slot, const Lag& window) const;
-  LagSys lag_system(const std::vector<std::size_t>& slots, const LagEstimate& at) const;
+  LagSys lag_system(const std::vector<std::size_t>& slots, const LagEstimate& at, MatrixWorkspace& memory) const;
   std::string lag_variable_at(const LagSys& sys, Eigen::Index row) const;
   typename Lag::Prior marginalized_prior(std::optional<std::size_t> pose, const std::vector<std::size_t>& slots,
-                                            const LagEstimate& at, const Lag& window) const;
+                                            const LagEstimate& at, const Lag& window, MatrixWorkspace& memory) const;
   void slide_window(LagPlan& plan, const std::vector<std::size_t>& slots, const LagSys& sys,
-                    const LagSolve& solved) const;
+                    const LagSolve& solved, MatrixWorkspace& memory) const;
   bool in_lag_prior(std::size_t slot) const;
   void step_lag(const std::vector<std::size_t>& touched_slots);
-  Lag lag_without(std::size_t slot) const;
+  Lag lag_without(std::size_t slot, MatrixWorkspace& memory) const;
 
   Motion motion_;
   Sensor sensor_;
@@ -280,6 +280,7 @@ class GraphSlam {
   VersionedCache<SelectedInverse> marginals_;  ///< at revision_ (thread-safe)
   Online online_;  ///< the incrementally factorized reduced system (online mode)
   Lag lag_;  ///< the window's prior and retired landmarks (fixed-lag mode)
+  LagScratch lag_scratch_;  ///< the fixed-lag step's dense blocks (scratch)
 };
 
 }  // namespace sextant

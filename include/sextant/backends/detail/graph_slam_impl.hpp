@@ -641,7 +641,7 @@ void GraphSlam<Motion, Sensor>::remove_landmark(LandmarkId id) {
   const std::size_t slot = landmarks_.slot(id);
   const bool online = options_.incremental && options_.lag == 0 && !online_.theta.empty();
   std::optional<Lag> lag;
-  if (options_.lag > 0) lag = lag_without(slot);
+  if (options_.lag > 0) lag = lag_without(slot, lag_scratch_.marginalization);
   std::optional<LinearFactor> factor;
   std::optional<typename Online::PoseFactor> held;  // online: the factor's blocks of S
   if (!online) {

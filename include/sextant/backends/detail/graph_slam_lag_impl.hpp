@@ -133,15 +133,15 @@ void GraphSlam<Motion, Sensor>::add_retired_prior(LagSys& sys, const LagEstimate
 /// landmark first: the prior's last), then the poses first .. newest (the newest last, so that its
 /// marginal is the factor's last block), with every factor on them.
 template <class Motion, class Sensor>
-auto GraphSlam<Motion, Sensor>::lag_system(const std::vector<std::size_t>& slots, const LagEstimate& at) const
-    -> LagSys {
+auto GraphSlam<Motion, Sensor>::lag_system(const std::vector<std::size_t>& slots, const LagEstimate& at,
+                                           MatrixWorkspace& memory) const -> LagSys {
   const std::size_t first = lag_.first, last = poses_.size() - 1;
   LagSys sys;
   for (std::size_t slot : slots)
     if (!in_lag_prior(slot)) sys.add_landmark(slot);
   for (std::size_t slot : slots) sys.add_landmark(slot);
   for (std::size_t p = first; p <= last; ++p) sys.add_pose(p);
-  sys.allocate();
+  sys.allocate(memory);
   add_lag_prior(sys, at, lag_.prior);
   if (first == 0) add_lag_pose_prior(sys, at);
   for (std::size_t k = first; k < last; ++k) add_lag_motion(sys, at, k);
@@ -177,7 +177,8 @@ std::string GraphSlam<Motion, Sensor>::lag_variable_at(const LagSys& sys, Eigen:
 /// window at `at`: the old prior and every factor on them, their variables eliminated.
 template <class Motion, class Sensor>
 auto GraphSlam<Motion, Sensor>::marginalized_prior(std::optional<std::size_t> pose, const std::vector<std::size_t>& slots,
-                                                   const LagEstimate& at, const Lag& window) const ->
+                                                   const LagEstimate& at, const Lag& window,
+                                                   MatrixWorkspace& memory) const ->
     typename Lag::Prior {
   const std::size_t last = poses_.size() - 1;
   auto seen_at = [&](std::size_t slot, std::size_t p) {
@@ -200,7 +201,7 @@ auto GraphSlam<Motion, Sensor>::marginalized_prior(std::optional<std::size_t> po
   for (std::size_t slot : slots)
     for (const auto& record : measurements_[slot])
       if (record.pose >= window.first) sys.add_pose(record.pose);
-  sys.allocate();
+  sys.allocate(memory);
   add_lag_prior(sys, at, window.prior);
   if (pose && *pose == 0) add_lag_pose_prior(sys, at);
   if (pose && *pose < last) add_lag_motion(sys, at, *pose);
@@ -234,7 +235,7 @@ auto GraphSlam<Motion, Sensor>::marginalized_prior(std::optional<std::size_t> po
 /// reuse_retired_marginals asks for it), at the plan's estimate.
 template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::slide_window(LagPlan& plan, const std::vector<std::size_t>& slots, const LagSys& sys,
-                                             const LagSolve& solved) const {
+                                             const LagSolve& solved, MatrixWorkspace& memory) const {
   const std::size_t last = poses_.size() - 1;
   const LagEstimate at{&plan.poses, &plan.means};
   while (last + 1 - plan.window.first > options_.lag) {
@@ -242,7 +243,7 @@ void GraphSlam<Motion, Sensor>::slide_window(LagPlan& plan, const std::vector<st
     std::vector<std::size_t> leaving;
     for (std::size_t slot : slots)
       if (measurements_[slot].back().pose == p) leaving.push_back(slot);
-    auto prior = marginalized_prior(p, leaving, at, plan.window);
+    auto prior = marginalized_prior(p, leaving, at, plan.window, memory);
     if (options_.reuse_retired_marginals)  // otherwise a landmark seen again starts from its window
       for (std::size_t slot : leaving) {
         const Eigen::Matrix<double, M, M> cov = symmetrized(solved.landmark_covariance(sys, sys.landmark_at.at(slot)));
@@ -262,10 +263,10 @@ template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::step_lag(const std::vector<std::size_t>& touched) {
   const std::size_t first = lag_.first, last = poses_.size() - 1;
   const std::vector<std::size_t> slots = lag_slots(touched);
-  const LagSys sys = lag_system(slots, {&poses_, &landmarks_.means().stacked()});
+  const LagSys sys = lag_system(slots, {&poses_, &landmarks_.means().stacked()}, lag_scratch_.window);
   Eigen::Index free_dims = sys.pose_at.at(first);  // the prior's landmarks follow the free ones
   for (LandmarkId id : lag_.prior.landmarks) free_dims = std::min(free_dims, sys.landmark_at.at(landmarks_.slot(id)));
-  const LagSolve solved(sys, free_dims, sys.pose_at.at(first));
+  const LagSolve solved(sys, free_dims, sys.pose_at.at(first), lag_scratch_.factor);
   const Eigen::VectorXd& delta = solved.delta;
   LagPlan plan{poses_, landmarks_.means().stacked(), lag_, {}};
   for (std::size_t p = first; p <= last; ++p) {
@@ -277,7 +278,7 @@ void GraphSlam<Motion, Sensor>::step_lag(const std::vector<std::size_t>& touched
   plan.newest_cov = symmetrized(solved.newest_pose_covariance());
   plan.window.seen_from.resize(poses_.size());
   for (std::size_t slot : touched) plan.window.seen_from[last].push_back(landmarks_.id_at(slot));
-  slide_window(plan, slots, sys, solved);
+  slide_window(plan, slots, sys, solved, lag_scratch_.marginalization);
   poses_ = std::move(plan.poses);
   landmarks_.means().stacked() = std::move(plan.means);
   lag_ = std::move(plan.window);
@@ -288,11 +289,11 @@ void GraphSlam<Motion, Sensor>::step_lag(const std::vector<std::size_t>& touched
 /// Fixed-lag bookkeeping of remove_landmark: a landmark the window sees is marginalized into the
 /// prior; a retired one is forgotten. Returns the window to commit.
 template <class Motion, class Sensor>
-auto GraphSlam<Motion, Sensor>::lag_without(std::size_t slot) const -> Lag {
+auto GraphSlam<Motion, Sensor>::lag_without(std::size_t slot, MatrixWorkspace& memory) const -> Lag {
   Lag out = lag_;
   const LandmarkId id = landmarks_.id_at(slot);
   if (measurements_[slot].back().pose >= lag_.first)
-    out.prior = marginalized_prior(std::nullopt, {slot}, {&poses_, &landmarks_.means().stacked()}, lag_);
+    out.prior = marginalized_prior(std::nullopt, {slot}, {&poses_, &landmarks_.means().stacked()}, lag_, memory);
   out.retired.erase(id);
   return out;
 }

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <map>
+#include <new>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -16,18 +17,30 @@
 #include "sextant/core/error.hpp"
 #include "sextant/core/factor_information.hpp"
 #include "sextant/core/gaussian.hpp"
+#include "sextant/core/matrix_workspace.hpp"
 #include "sextant/core/observation.hpp"
 
 namespace sextant {
 
+/// The dense blocks of one fixed-lag step, kept from step to step (scratch: a copy starts empty).
+/// Allocated afresh each frame (~2.5 MB for the window's H on the default globe), glibc handed them
+/// to the kernel and back and a virtual machine charged 3-7 ms a frame for the fresh pages on a
+/// fifth of the frames (docs/results/real_time.md, "Fixed lag: memory kept between frames").
+struct LagScratch {
+  MatrixWorkspace window;          ///< the window's H (lag_system)
+  MatrixWorkspace factor;          ///< the window's reduced system and its Cholesky factor (LagSolution)
+  MatrixWorkspace marginalization; ///< H of what leaves the window (marginalized_prior)
+};
+
 /// The dense normal equations H delta = b over an ordered set of variables: landmarks (by slot) and
-/// poses (by index), each placed where it was added.
+/// poses (by index), each placed where it was added. H lives in a MatrixWorkspace, which must outlive
+/// the system and not hand it out again meanwhile.
 template <int X, int M>
 struct LagSystem {
   std::unordered_map<std::size_t, Eigen::Index> landmark_at;
   std::map<std::size_t, Eigen::Index> pose_at;
   Eigen::Index dims = 0;
-  Eigen::MatrixXd H;
+  MatrixWorkspace::View H{nullptr, 0, 0, Eigen::OuterStride<>(1)};
   Eigen::VectorXd b;
 
   void add_landmark(std::size_t slot) {
@@ -36,9 +49,10 @@ struct LagSystem {
   void add_pose(std::size_t pose) {
     if (pose_at.emplace(pose, dims).second) dims += X;
   }
-  /// Zero H and b once every variable is placed.
-  void allocate() {
-    H.setZero(dims, dims);
+  /// Zero H (in `memory`) and b once every variable is placed.
+  void allocate(MatrixWorkspace& memory) {
+    new (&H) MatrixWorkspace::View(memory.view(dims));  // re-seating a Map, as Eigen documents it
+    H.setZero();
     b.setZero(dims);
   }
   /// H[i, k] += block and, off the diagonal, H[k, i] += block^T.
@@ -93,11 +107,12 @@ struct LagSolution {
   using Block = Eigen::Matrix<double, M, M>;
   Eigen::Index free_dims = 0, pose_begin = 0;
   std::vector<Eigen::LLT<Block>> free;  ///< H_jj of each free landmark
-  Eigen::MatrixXd factor;  ///< S's Cholesky factor in its lower triangle (core/dense_cholesky.hpp)
+  MatrixWorkspace::View factor;  ///< S's Cholesky factor in its lower triangle (core/dense_cholesky.hpp), in `memory`
   Eigen::VectorXd delta;
 
-  LagSolution(const LagSystem<X, M>& sys, Eigen::Index free_dims_, Eigen::Index pose_begin_)
-      : free_dims(free_dims_), pose_begin(pose_begin_) {
+  /// `memory` holds the factor and must outlive the solution.
+  LagSolution(const LagSystem<X, M>& sys, Eigen::Index free_dims_, Eigen::Index pose_begin_, MatrixWorkspace& memory)
+      : free_dims(free_dims_), pose_begin(pose_begin_), factor(memory.view(sys.dims - free_dims_)) {
     const Eigen::Index rest = sys.dims - free_dims, poses = sys.dims - pose_begin;
     factor = sys.H.bottomRightCorner(rest, rest);
     Eigen::VectorXd g = sys.b.tail(rest);
