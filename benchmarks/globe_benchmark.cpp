@@ -165,6 +165,17 @@ void BM_GlobeGraphOnline120Steps(benchmark::State& state) {
   }
 }
 
+/// GraphSLAM as a fixed-lag smoother (GraphOptions::lag = 10) on the same frames: at this scale ten
+/// frames see ~1000 landmarks, so the window's dense system has ~3000 dimensions (docs/results/
+/// real_time.md, "Fixed lag: memory kept between frames").
+void BM_GlobeGraphFixedLag120Steps(benchmark::State& state) {
+  const auto& data = real_scale_globe();
+  for (auto _ : state) {
+    GraphSlam<EulerCamera12D, PointInCamera3D> graph(data.motion, data.sensor, data.prior, {.lag = 10});
+    run_timed(graph, state);
+  }
+}
+
 void BM_GlobeGraphOneGlobalUpdate(benchmark::State& state) {
   const auto& data = real_scale_globe();
   GraphSlam<EulerCamera12D, PointInCamera3D> graph(data.motion, data.sensor, data.prior, {.max_iterations = 1});
@@ -255,6 +266,7 @@ BENCHMARK(BM_GlobeEkfUpdateAtFinalSize)->Iterations(3)->Unit(benchmark::kMillise
 BENCHMARK(BM_GlobeSeif120Steps)->Arg(150)->Arg(250)->Arg(1000)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GlobeRelocalizingSeif120Steps)->Arg(150)->Arg(250)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GlobeGraphOnline120Steps)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK(BM_GlobeGraphFixedLag120Steps)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GlobeGraphOneGlobalUpdate)->Iterations(3)->Unit(benchmark::kSecond);
 BENCHMARK(BM_GlobeGraphMarginals)
     ->ArgsProduct({{30, 60, 100}, {0, 1}})
