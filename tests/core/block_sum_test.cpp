@@ -73,5 +73,12 @@ TEST(BlockSum, SymmetricBlocksLandTransposed) {
   EXPECT_EQ(sum.blocks(), 2u);
 }
 
+TEST(BlockSum, AnEmptySumIsTheZeroMatrix) {
+  const Eigen::SparseMatrix<double> empty = BlockSum<6>{}.to_sparse(24, 18);
+  EXPECT_EQ(empty.rows(), 24);
+  EXPECT_EQ(empty.cols(), 18);
+  EXPECT_EQ(empty.nonZeros(), 0);
+}
+
 }  // namespace
 }  // namespace sextant

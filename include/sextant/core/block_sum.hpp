@@ -3,7 +3,7 @@
 /// landmark seen from k poses adds k^2 blocks to GraphSLAM's reduced system (thesis eq. 68); as
 /// triplets that is 36 k^2 entries of 16 bytes each (1-2 GB on a visual-inertial log of 1105 frames),
 /// whose allocation and first touch cost more than the factorization. Summed here, each block of the
-/// grid is one dense block, written once into BlockTriplets.
+/// grid is one dense block, written once into the compressed matrix.
 ///
 /// Each block's contributions are summed in the order they were added, which is the order
 /// setFromTriplets sums duplicate entries in: the matrix is the one BlockTriplets builds from every
@@ -18,11 +18,14 @@
 /// 1.06x slower over five pairs the same evening. A solve builds its sum anew.
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <algorithm>
 #include <cstdint>
+#include <numeric>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
-#include "sextant/core/block_triplets.hpp"
 
 namespace sextant {
 
@@ -49,15 +52,49 @@ class BlockSum {
 
   std::size_t blocks() const { return blocks_.size(); }
 
+  /// The sum as a compressed column-major matrix, written in place block column by block column: the
+  /// matrix BlockTriplets::to_sparse builds from the summed blocks (each entry once, so nothing is
+  /// summed there), without its triplets and row-major copy. At the thesis's globe scale the reduced
+  /// system has ~2 M entries, and those two buffers (~56 MB a solve, allocated afresh) cost a virtual
+  /// machine that backs fresh pages slowly more than the solve's arithmetic (docs/benchmarks.md,
+  /// "GraphSLAM's reduced system without triplets").
   Eigen::SparseMatrix<double> to_sparse(Eigen::Index rows, Eigen::Index cols) const {
-    BlockTriplets triplets;
-    triplets.reserve(blocks_.size() * Rows * Cols);
-    for (const auto& b : blocks_)
-      triplets.add(Rows * static_cast<Eigen::Index>(b.i), Cols * static_cast<Eigen::Index>(b.j), b.sum);
-    return triplets.to_sparse(rows, cols);
+    std::vector<std::size_t> order(blocks_.size());  // by block column, then block row
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return std::tie(blocks_[a].j, blocks_[a].i) < std::tie(blocks_[b].j, blocks_[b].i);
+    });
+    std::vector<Eigen::Index> in_block_column((static_cast<std::size_t>(cols) + Cols - 1) / Cols, 0);
+    for (const auto& b : blocks_) ++in_block_column.at(b.j);
+    Eigen::SparseMatrix<double> out(rows, cols);
+    out.resizeNonZeros(Rows * Cols * static_cast<Eigen::Index>(blocks_.size()));
+    auto* outer = out.outerIndexPtr();
+    Eigen::Index at = 0;
+    for (Eigen::Index c = 0; c < cols; ++c) {
+      outer[c] = static_cast<StorageIndex>(at);
+      at += Rows * in_block_column[static_cast<std::size_t>(c / Cols)];
+    }
+    outer[cols] = static_cast<StorageIndex>(at);
+    std::size_t column_of_previous = blocks_.size() == 0 ? 0 : blocks_[order.front()].j;
+    Eigen::Index kth = 0;  // the block's place in its block column
+    for (std::size_t k : order) {
+      const Entry& b = blocks_[k];
+      kth = b.j == column_of_previous ? kth : 0;
+      column_of_previous = b.j;
+      for (int cc = 0; cc < Cols; ++cc) {
+        const Eigen::Index first = outer[Cols * static_cast<Eigen::Index>(b.j) + cc] + Rows * kth;
+        for (int r = 0; r < Rows; ++r) {
+          out.innerIndexPtr()[first + r] = static_cast<StorageIndex>(Rows * static_cast<Eigen::Index>(b.i) + r);
+          out.valuePtr()[first + r] = b.sum(r, cc);
+        }
+      }
+      ++kth;
+    }
+    return out;
   }
 
  private:
+  using StorageIndex = Eigen::SparseMatrix<double>::StorageIndex;
   struct Entry {
     std::size_t i, j;
     Block sum;
