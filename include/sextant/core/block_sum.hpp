@@ -26,7 +26,6 @@
 #include <unordered_map>
 #include <vector>
 
-
 namespace sextant {
 
 template <int Rows, int Cols = Rows>
@@ -75,12 +74,10 @@ class BlockSum {
       at += Rows * in_block_column[static_cast<std::size_t>(c / Cols)];
     }
     outer[cols] = static_cast<StorageIndex>(at);
-    std::size_t column_of_previous = blocks_.size() == 0 ? 0 : blocks_[order.front()].j;
-    Eigen::Index kth = 0;  // the block's place in its block column
+    std::vector<Eigen::Index> placed(in_block_column.size(), 0);  // blocks written in each block column
     for (std::size_t k : order) {
       const Entry& b = blocks_[k];
-      kth = b.j == column_of_previous ? kth : 0;
-      column_of_previous = b.j;
+      const Eigen::Index kth = placed[b.j]++;  // the block's place in its block column (rows ascending)
       for (int cc = 0; cc < Cols; ++cc) {
         const Eigen::Index first = outer[Cols * static_cast<Eigen::Index>(b.j) + cc] + Rows * kth;
         for (int r = 0; r < Rows; ++r) {
@@ -88,7 +85,6 @@ class BlockSum {
           out.valuePtr()[first + r] = b.sum(r, cc);
         }
       }
-      ++kth;
     }
     return out;
   }
