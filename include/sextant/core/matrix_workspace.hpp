@@ -5,9 +5,8 @@
 /// at the thesis's scale; the trailing block of the incremental GraphSLAM's profile Cholesky; the
 /// fixed-lag window's normal equations and factor) then allocates, and page-faults, a few times in a
 /// run instead of every step. Copies start empty: scratch is not state. From 2 MB on the buffer is
-/// backed by huge pages (core/huge_pages.hpp): a
-/// block's 3 x 3 sub-blocks are read across columns a few KB apart, one 4 KB page each, which in a
-/// virtual machine was a TLB miss each.
+/// backed by huge pages (core/huge_pages.hpp): a block's 3 x 3 sub-blocks are read across columns a
+/// few KB apart, one 4 KB page each, which in a virtual machine was a TLB miss each.
 
 #include <Eigen/Core>
 #include <algorithm>
