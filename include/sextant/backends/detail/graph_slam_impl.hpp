@@ -44,6 +44,7 @@ struct GraphSlam<Motion, Sensor>::Linearization {
   /// The whole information matrix (poses, then landmarks in this system's order), whole blocks stored.
   Eigen::SparseMatrix<double> assemble() const {
     BlockTriplets triplets;
+    triplets.reserve(entries());  // grown by doubling, its buffers were most of a solve's fresh pages
     for (std::size_t p = 0; p < pose_count; ++p) triplets.add(X * p, X * p, pose_diagonal[p]);
     for (const auto& link : pose_links) triplets.add_symmetric(X * link.a, X * link.b, link.block);
     const Eigen::Index base = X * static_cast<Eigen::Index>(pose_count);
@@ -53,6 +54,12 @@ struct GraphSlam<Motion, Sensor>::Linearization {
       for (const auto& [p, block] : landmarks[j].poses) triplets.add_symmetric(X * p, row, block);
     }
     return triplets.to_sparse(dim(), dim());
+  }
+  /// The entries assemble() writes.
+  std::size_t entries() const {
+    std::size_t pose_landmark = 0;
+    for (const auto& landmark : landmarks) pose_landmark += landmark.poses.size();
+    return X * X * (pose_count + 2 * pose_links.size()) + M * M * landmarks.size() + 2 * X * M * pose_landmark;
   }
 };
 
