@@ -1,5 +1,5 @@
 #pragma once
-/// \file Fixed-size blocks summed where they meet on a block grid before they become triplets. A
+/// \file Fixed-size blocks summed where they meet on a block grid before they become a sparse matrix. A
 /// landmark seen from k poses adds k^2 blocks to GraphSLAM's reduced system (thesis eq. 68); as
 /// triplets that is 36 k^2 entries of 16 bytes each (1-2 GB on a visual-inertial log of 1105 frames),
 /// whose allocation and first touch cost more than the factorization. Summed here, each block of the

@@ -1,8 +1,9 @@
 #pragma once
-/// \file The one block-sparse assembly: dense blocks written into a sparse matrix at (row, col),
-/// entries that meet summed (Eigen's setFromTriplets), in the order the blocks were added. GraphSLAM's
-/// normal equations, SEIF's information matrix and (through core/block_sum.hpp, which sums its
-/// blocks first) GraphSLAM's reduced system are assembled with it.
+/// \file Block-sparse assembly of blocks of any size at any place: dense blocks written into a sparse
+/// matrix at (row, col), entries that meet summed (Eigen's setFromTriplets), in the order the blocks
+/// were added. GraphSLAM's normal equations and SEIF's information matrix are assembled with it;
+/// GraphSLAM's reduced system, fixed-size blocks on a grid, goes through core/block_sum.hpp, which
+/// sums them first and writes the matrix itself (the same matrix as through this assembly).
 
 #include <Eigen/SparseCore>
 #include <vector>
