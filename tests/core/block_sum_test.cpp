@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sextant/core/block_triplets.hpp"
+#include "support/sparse_bit_identical.hpp"
 
 namespace sextant {
 namespace {
@@ -33,13 +34,7 @@ std::vector<Contribution> contributions(std::mt19937& rng) {
   return out;
 }
 
-bool bit_identical(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix<double>& b) {
-  if (a.rows() != b.rows() || a.cols() != b.cols() || a.nonZeros() != b.nonZeros()) return false;
-  for (Eigen::Index c = 0; c < a.outerSize(); ++c)
-    for (Eigen::SparseMatrix<double>::InnerIterator x(a, c), y(b, c); x; ++x, ++y)
-      if (!y || x.row() != y.row() || x.value() != y.value()) return false;
-  return true;
-}
+using test::bit_identical;
 
 TEST(BlockSum, IsTheTripletAssemblyBitForBit) {
   std::mt19937 rng(7);

@@ -8,8 +8,8 @@
 #include <utility>
 
 #include "sextant/core/landmark_init.hpp"
+#include "sextant/core/block_columns.hpp"
 #include "sextant/core/block_sum.hpp"
-#include "sextant/core/block_triplets.hpp"
 #include "sextant/core/factor_information.hpp"
 #include "sextant/core/linearized_observation.hpp"
 #include "sextant/core/sparse_cholesky.hpp"
@@ -41,25 +41,71 @@ struct GraphSlam<Motion, Sensor>::Linearization {
 
   Eigen::Index dim() const { return X * static_cast<Eigen::Index>(pose_count) + M * static_cast<Eigen::Index>(landmarks.size()); }
 
-  /// The whole information matrix (poses, then landmarks in this system's order), whole blocks stored.
-  Eigen::SparseMatrix<double> assemble() const {
-    BlockTriplets triplets;
-    triplets.reserve(entries());  // grown by doubling, its buffers were most of a solve's fresh pages
-    for (std::size_t p = 0; p < pose_count; ++p) triplets.add(X * p, X * p, pose_diagonal[p]);
-    for (const auto& link : pose_links) triplets.add_symmetric(X * link.a, X * link.b, link.block);
-    const Eigen::Index base = X * static_cast<Eigen::Index>(pose_count);
-    for (std::size_t j = 0; j < landmarks.size(); ++j) {
-      const Eigen::Index row = base + M * static_cast<Eigen::Index>(j);
-      triplets.add(row, row, landmarks[j].diagonal);
-      for (const auto& [p, block] : landmarks[j].poses) triplets.add_symmetric(X * p, row, block);
-    }
-    return triplets.to_sparse(dim(), dim());
+  /// The information matrix (poses, then landmarks in this system's order), written block column by
+  /// block column (core/block_columns.hpp). `Triangle::both`: every block, as information_matrix()
+  /// and the marginals need; `Triangle::lower`: the blocks on and below the diagonal, all a sparse
+  /// Cholesky of the lower triangle reads (half the pose-landmark blocks, which are most of it).
+  enum class Triangle { both, lower };
+  Eigen::SparseMatrix<double> assemble(Triangle triangle = Triangle::both) const {
+    const bool both = triangle == Triangle::both;
+    const PoseColumns columns = pose_columns(both);
+    std::vector<ColumnBlock> landmark_column;
+    Eigen::Index nonzeros = 0;
+    for (std::size_t p = 0; p < pose_count; ++p) nonzeros += BlockColumnWriter::entries(X, columns.of(p));
+    for (const auto& terms : landmarks) nonzeros += BlockColumnWriter::entries(M, landmark_blocks(terms, both, landmark_column));
+    BlockColumnWriter out(dim(), dim(), nonzeros);
+    for (std::size_t p = 0; p < pose_count; ++p) out.write(X, columns.of(p));
+    for (const auto& terms : landmarks) out.write(M, landmark_blocks(terms, both, landmark_column));
+    return out.finish();
   }
-  /// The entries assemble() writes.
-  std::size_t entries() const {
-    std::size_t pose_landmark = 0;
-    for (const auto& landmark : landmarks) pose_landmark += landmark.poses.size();
-    return X * X * (pose_count + 2 * pose_links.size()) + M * M * landmarks.size() + 2 * X * M * pose_landmark;
+
+ private:
+  /// Each pose's block column: its pose rows (its diagonal block, its links; those at one pair in the
+  /// order of pose_links) and below them the landmarks it saw, in this system's order.
+  struct PoseColumns {
+    std::vector<std::size_t> start;  ///< pose p's blocks are blocks[start[p], start[p + 1])
+    std::vector<ColumnBlock> blocks;
+    std::span<const ColumnBlock> of(std::size_t p) const { return {blocks.data() + start[p], blocks.data() + start[p + 1]}; }
+  };
+  PoseColumns pose_columns(bool both) const {
+    PoseColumns out;
+    std::vector<std::size_t> count(pose_count + 1, 0);  // blocks of pose p's column counted at p + 1
+    for (std::size_t p = 0; p < pose_count; ++p) ++count[p + 1];
+    for (const auto& link : pose_links) {
+      ++count[link.a + 1];  // (b, a): below the diagonal
+      if (both) ++count[link.b + 1];
+    }
+    for (const auto& terms : landmarks)
+      for (const auto& pose_block : terms.poses) ++count[pose_block.first + 1];
+    for (std::size_t p = 0; p < pose_count; ++p) count[p + 1] += count[p];
+    out.start = count;
+    out.blocks.resize(count[pose_count]);
+    std::vector<std::size_t> next(count.begin(), count.end() - 1);
+    const Eigen::Index base = X * static_cast<Eigen::Index>(pose_count);
+    for (std::size_t p = 0; p < pose_count; ++p) out.blocks[next[p]++] = {X * static_cast<Eigen::Index>(p), X, pose_diagonal[p].data()};
+    for (const auto& link : pose_links) {
+      out.blocks[next[link.a]++] = {X * static_cast<Eigen::Index>(link.b), X, link.block.data(), true};
+      if (both) out.blocks[next[link.b]++] = {X * static_cast<Eigen::Index>(link.a), X, link.block.data()};
+    }
+    for (std::size_t p = 0; p < pose_count; ++p)  // the pose rows by row, one pair's blocks in order
+      std::stable_sort(out.blocks.begin() + out.start[p], out.blocks.begin() + next[p],
+                       [](const ColumnBlock& l, const ColumnBlock& r) { return l.row < r.row; });
+    for (std::size_t j = 0; j < landmarks.size(); ++j)
+      for (const auto& [p, block] : landmarks[j].poses)
+        out.blocks[next[p]++] = {base + M * static_cast<Eigen::Index>(j), M, block.data(), true};
+    return out;
+  }
+  /// Landmark j's block column: the poses that saw it (by pose, one pose's blocks in order), then its
+  /// diagonal block; only the diagonal block for the lower triangle.
+  std::span<const ColumnBlock> landmark_blocks(const LandmarkTerms& terms, bool both, std::vector<ColumnBlock>& out) const {
+    out.clear();
+    if (both) {
+      for (const auto& [p, block] : terms.poses) out.push_back({X * static_cast<Eigen::Index>(p), X, block.data()});
+      std::stable_sort(out.begin(), out.end(), [](const ColumnBlock& l, const ColumnBlock& r) { return l.row < r.row; });
+    }
+    const Eigen::Index row = X * static_cast<Eigen::Index>(pose_count) + M * static_cast<Eigen::Index>(&terms - landmarks.data());
+    out.push_back({row, M, terms.diagonal.data()});
+    return out;
   }
 };
 
@@ -339,9 +385,11 @@ auto GraphSlam<Motion, Sensor>::measurement_information(std::size_t slot, const 
 /// Each measurement of each landmark (eqs. 62-63); one the model cannot evaluate sits this one out.
 template <class Motion, class Sensor>
 void GraphSlam<Motion, Sensor>::add_measurement_factors(Linearization& sys) const {
+  sys.landmarks.reserve(measurements_.size());  // grown by doubling, both were fresh pages of every solve
   for (std::size_t slot = 0; slot < measurements_.size(); ++slot) {
     typename Linearization::LandmarkTerms terms;
     terms.slot = slot;
+    terms.poses.reserve(measurements_[slot].size());
     for (const auto& record : measurements_[slot]) {
       if (record.pose >= sys.pose_count) continue;
       const auto info = measurement_information(slot, record, poses_[record.pose], landmark_mean(slot));
@@ -410,7 +458,7 @@ template <class Motion, class Sensor>
 Eigen::VectorXd GraphSlam<Motion, Sensor>::solve_full(const Linearization& sys, OptimizationSummary& summary) const {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  const Eigen::SparseMatrix<double> A = sys.assemble();
+  const Eigen::SparseMatrix<double> A = sys.assemble(Linearization::Triangle::lower);
   Eigen::VectorXd b(sys.dim());
   b.head(sys.pose_rhs.size()) = sys.pose_rhs;
   for (std::size_t j = 0; j < sys.landmarks.size(); ++j) b.template segment<M>(sys.pose_rhs.size() + M * j) = sys.landmarks[j].rhs;
