@@ -2,7 +2,7 @@
 /// \file A compressed column-major matrix written block column by block column from dense blocks
 /// whose places the caller already knows in order, with no triplets and no sorting copy. GraphSLAM's
 /// full system (poses and landmarks, thesis eqs. 58-64) has ~4.5 M entries on the default globe: as
-/// triplets (16 bytes each) and Eigen's row-major copy in setFromTriplets they were 54% of a global
+/// triplets (16 bytes each) and Eigen's row-major copy in setFromTriplets they were 53% of a global
 /// update's fresh pages (docs/benchmarks.md, "GraphSLAM's full system without triplets").
 ///
 /// Blocks that meet at one place are summed in the order given, the order setFromTriplets sums

@@ -1,9 +1,10 @@
 #pragma once
 /// \file Block-sparse assembly of blocks of any size at any place: dense blocks written into a sparse
 /// matrix at (row, col), entries that meet summed (Eigen's setFromTriplets), in the order the blocks
-/// were added. GraphSLAM's normal equations and SEIF's information matrix are assembled with it;
-/// GraphSLAM's reduced system, fixed-size blocks on a grid, goes through core/block_sum.hpp, which
-/// sums them first and writes the matrix itself (the same matrix as through this assembly).
+/// were added. SEIF's information matrix and the pose graph's chordal start are assembled with it;
+/// GraphSLAM writes its systems itself, the same matrices as through this assembly: the reduced one
+/// through core/block_sum.hpp (fixed-size blocks summed on a grid), the whole one through
+/// core/block_columns.hpp (blocks whose places it knows column by column).
 
 #include <Eigen/SparseCore>
 #include <vector>
