@@ -278,7 +278,8 @@ class GraphSlam {
   std::vector<Eigen::Matrix<double, X, 1>> entry_sigma_;  ///< each pose's standard deviations as it was added (online mode)
   /// Keeps the symbolic analysis while the pattern is unchanged (non-const paths only). CHOLMOD chooses
   /// simplicial or supernodal by the factor's fill, as for pose graphs and as Ceres lets it: the
-  /// whole system's factor is sparse on the ship and cityTrees (2.6x and 3.9x faster than supernodal);
+  /// whole system's factor is sparse on the ship and cityTrees (2.5-2.9x and 3.2-3.5x faster than
+  /// supernodal on the same assembly);
   /// the globe's systems and the ship's landmark Schur complement took the same time either way
   /// (docs/benchmarks.md, "GraphSLAM vs Ceres").
   mutable SparseCholesky solver_{SparseCholesky::Factorization::by_fill};
