@@ -327,6 +327,27 @@ TEST_F(WrittenRawlog, BadLogsGiveOneLineErrorsNamingFileAndProblem) {
   EXPECT_NE(error_of(truncated).find(truncated + ": entry 3: truncated or malformed"), std::string::npos);
   EXPECT_EQ(read_rawlog_2d(whole).steps.size(), 2u);
 
+  // A log of a sensor MRPT knows but this build does not register (MRPT's own rot_scan_2d.rawlog
+  // holds CObservationRotatingScan, of mrpt-maps): named as such, not called malformed. Made here
+  // by renaming the observation's class in the bytes of a good log.
+  std::string bytes;
+  {
+    std::ifstream in(whole, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::string known_class = "CObservationBearingRange", unknown_class = "CObservationBearingRangX";
+  ASSERT_NE(bytes.find(known_class), std::string::npos);
+  for (auto at = bytes.find(known_class); at != std::string::npos; at = bytes.find(known_class, at))
+    bytes.replace(at, known_class.size(), unknown_class);
+  const auto foreign = (dir / "foreign.rawlog").string();
+  std::ofstream(foreign, std::ios::binary) << bytes;
+  const auto foreign_error = error_of(foreign);
+  EXPECT_NE(foreign_error.find(foreign + ": entry 1: an object of class mrpt::obs::CObservationBearingRangX, which "
+                                         "this reader cannot read"),
+            std::string::npos)
+      << foreign_error;
+  EXPECT_EQ(foreign_error.find("malformed"), std::string::npos) << foreign_error;
+
   const auto mixed = write("mixed.rawlog", false, action(0.5, 0.0, 0.1), frame(bearing({{4, 2.0f}})),
                            action(0.5, 0.0, 0.1), frame(bearing({{-1, 2.0f}})));
   EXPECT_NE(error_of(mixed).find("entry 3: some landmarks have ids and some have none"), std::string::npos);

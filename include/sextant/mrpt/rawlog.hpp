@@ -65,6 +65,18 @@ enum class RawlogKind { planar, spatial };
 
 namespace detail {
 
+/// The class named by MRPT's error for an object of a class it does not know ("Stored object has
+/// class 'X' which is not registered!"): a log of other sensors (a rotating scan, an image), not a
+/// damaged one. nullopt for any other error.
+inline std::optional<std::string> unreadable_class(const std::string& message) {
+  const std::string before = "Stored object has class '", after = "' which is not registered";
+  const auto open = message.find(before);
+  if (open == std::string::npos) return std::nullopt;
+  const auto first = open + before.size(), close = message.find(after, first);
+  if (close == std::string::npos) return std::nullopt;
+  return message.substr(first, close - first);
+}
+
 /// Every serialized object of the file, in order.
 inline std::vector<::mrpt::serialization::CSerializable::Ptr> read_objects(const std::string& path) {
   io::require_input_file(path);
@@ -78,8 +90,11 @@ inline std::vector<::mrpt::serialization::CSerializable::Ptr> read_objects(const
       objects.push_back(archive.ReadObject());
     } catch (const std::exception& e) {
       if (in.getPosition() == start) break;  // nothing of a next entry: the end of the log
-      throw parse_error(path + ": entry " + std::to_string(objects.size()) + ": truncated or malformed rawlog (" +
-                        exception_message(e.what()) + ")");
+      const std::string entry = path + ": entry " + std::to_string(objects.size()) + ": ";
+      if (const auto name = unreadable_class(e.what()))  // anywhere in the text: nested objects nest the errors
+        throw parse_error(entry + "an object of class " + *name + ", which this reader cannot read; it reads landmark " +
+                          "logs (odometry and CObservationBearingRange), and a rawlog's entries cannot be skipped");
+      throw parse_error(entry + "truncated or malformed rawlog (" + exception_message(e.what()) + ")");
     }
     if (!objects.back()) throw parse_error(path + ": entry " + std::to_string(objects.size() - 1) + ": empty object");
   }
