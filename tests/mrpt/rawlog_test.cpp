@@ -234,6 +234,18 @@ class WrittenRawlog : public ::testing::Test {
     return path;
   }
 
+  /// A copy of the log at `path`, named `name` in the test's directory, whose bytes `edit` changed
+  /// (a log damaged or altered on purpose); its path.
+  template <class Edit>
+  std::string edited_copy(const std::string& path, const std::string& name, Edit edit) const {
+    std::ifstream in(path, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    edit(bytes);
+    const auto copy = (dir / name).string();
+    std::ofstream(copy, std::ios::binary) << bytes;
+    return copy;
+  }
+
   /// The parse_error message of reading `path` as a planar log (fails the test if none).
   static std::string error_of(const std::string& path) {
     try {
@@ -330,17 +342,13 @@ TEST_F(WrittenRawlog, BadLogsGiveOneLineErrorsNamingFileAndProblem) {
   // A log of a sensor MRPT knows but this build does not register (MRPT's own rot_scan_2d.rawlog
   // holds CObservationRotatingScan, of mrpt-maps): named as such, not called malformed. Made here
   // by renaming the observation's class in the bytes of a good log.
-  std::string bytes;
-  {
-    std::ifstream in(whole, std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
   const std::string known_class = "CObservationBearingRange", unknown_class = "CObservationBearingRangX";
-  ASSERT_NE(bytes.find(known_class), std::string::npos);
-  for (auto at = bytes.find(known_class); at != std::string::npos; at = bytes.find(known_class, at))
-    bytes.replace(at, known_class.size(), unknown_class);
-  const auto foreign = (dir / "foreign.rawlog").string();
-  std::ofstream(foreign, std::ios::binary) << bytes;
+  std::size_t renamed = 0;
+  const auto foreign = edited_copy(whole, "foreign.rawlog", [&](std::string& bytes) {
+    for (auto at = bytes.find(known_class); at != std::string::npos; at = bytes.find(known_class, at), ++renamed)
+      bytes.replace(at, known_class.size(), unknown_class);
+  });
+  ASSERT_GT(renamed, 0u);
   const auto foreign_error = error_of(foreign);
   EXPECT_NE(foreign_error.find(foreign + ": entry 1: an object of class mrpt::obs::CObservationBearingRangX, which "
                                          "this reader cannot read"),
@@ -453,18 +461,17 @@ class CorruptLengthField : public WrittenRawlog {
   /// with `value` and returns the reader's error.
   template <class... Objects>
   std::string error_after_corrupting(std::uint32_t field, std::uint32_t value, const Objects&... objects) {
-    const auto path = write("long.rawlog", true, objects...);
-    std::ifstream in(path, std::ios::binary);
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     const std::string pattern(reinterpret_cast<const char*>(&field), sizeof field);
-    const auto at = bytes.find(pattern);
-    if (at == std::string::npos || bytes.find(pattern, at + 1) != std::string::npos) {
+    bool once = false;
+    const auto corrupt = edited_copy(write("long.rawlog", true, objects...), "corrupt.rawlog", [&](std::string& bytes) {
+      const auto at = bytes.find(pattern);
+      once = at != std::string::npos && bytes.find(pattern, at + 1) == std::string::npos;
+      if (once) bytes.replace(at, sizeof value, reinterpret_cast<const char*>(&value), sizeof value);
+    });
+    if (!once) {
       ADD_FAILURE() << "the field " << field << " does not occur exactly once in the log";
       return {};
     }
-    bytes.replace(at, sizeof value, reinterpret_cast<const char*>(&value), sizeof value);
-    const auto corrupt = (dir / "corrupt.rawlog").string();
-    std::ofstream(corrupt, std::ios::binary) << bytes;
     return error_of(corrupt);
   }
   void expect_malformed_entry_1(const std::string& message) {
