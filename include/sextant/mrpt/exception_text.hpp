@@ -2,6 +2,7 @@
 /// \file The message of an MRPT exception, for sextant's own error texts.
 
 #include <algorithm>
+#include <optional>
 #include <string>
 
 namespace sextant::mrpt_io {
@@ -24,6 +25,18 @@ inline std::string exception_message(const std::string& text) {
     return line;
   }
   return "unreadable data";
+}
+
+/// The class named by MRPT's error for an object of a class it does not know ("Stored object has
+/// class 'X' which is not registered!"): a log of other sensors (a rotating scan, an image), not a
+/// damaged one. nullopt for any other error.
+inline std::optional<std::string> unreadable_class(const std::string& message) {
+  const std::string before = "Stored object has class '", after = "' which is not registered";
+  const auto open = message.find(before);
+  if (open == std::string::npos) return std::nullopt;
+  const auto first = open + before.size(), close = message.find(after, first);
+  if (close == std::string::npos) return std::nullopt;
+  return message.substr(first, close - first);
 }
 
 }  // namespace sextant::mrpt_io

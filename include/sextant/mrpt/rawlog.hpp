@@ -65,18 +65,6 @@ enum class RawlogKind { planar, spatial };
 
 namespace detail {
 
-/// The class named by MRPT's error for an object of a class it does not know ("Stored object has
-/// class 'X' which is not registered!"): a log of other sensors (a rotating scan, an image), not a
-/// damaged one. nullopt for any other error.
-inline std::optional<std::string> unreadable_class(const std::string& message) {
-  const std::string before = "Stored object has class '", after = "' which is not registered";
-  const auto open = message.find(before);
-  if (open == std::string::npos) return std::nullopt;
-  const auto first = open + before.size(), close = message.find(after, first);
-  if (close == std::string::npos) return std::nullopt;
-  return message.substr(first, close - first);
-}
-
 /// Every serialized object of the file, in order.
 inline std::vector<::mrpt::serialization::CSerializable::Ptr> read_objects(const std::string& path) {
   io::require_input_file(path);
