@@ -41,8 +41,12 @@ int main(int argc, char** argv) {
     std::printf("%s: %zu poses, %zu landmarks; %d iterations, %s; chi2 %.6g -> %.6g; linearize %.3f s, eliminate %.3f s, "
                 "solve %.3f s (%s)\n",
                 path.c_str(), graph.num_poses(), graph.num_landmarks(), summary.iterations,
-                summary.converged ? "converged" : "NOT converged", summary.cost.front(), summary.cost.back(),
+                summary.converged ? "converged" : "NOT converged", summary.cost.front(),
+                summary.cost[static_cast<std::size_t>(summary.best_iteration)],
                 summary.seconds_linearize, summary.seconds_eliminate, summary.seconds_solve, SparseCholesky::backend());
+    if (summary.best_iteration != summary.iterations)
+      std::printf("the estimate is iteration %d's, the lowest chi2; the last one ended at %.6g\n", summary.best_iteration,
+                  summary.cost.back());
     if (!out_dir.empty()) {
       std::filesystem::create_directories(out_dir);
       io::CsvWriter poses((std::filesystem::path(out_dir) / "poses.csv").string(), {"x", "y", "heading"});

@@ -92,6 +92,9 @@ struct OptimizationSummary {
   /// Measurement factors the model could not evaluate at the final estimate (unobservable_error, e.g.
   /// a landmark behind the camera), left out of the last linearization.
   std::size_t unobservable_factors = 0;
+  /// The iteration whose estimate optimize() kept (0: the start): the last one unless an earlier one
+  /// had the lower cost (Gauss-Newton need not descend; Levenberg-Marquardt always keeps the last).
+  int best_iteration = 0;
 };
 
 /// GraphSLAM: records the prior, every motion and every measurement through the filters' face
@@ -183,6 +186,7 @@ class GraphSlam {
     Eigen::VectorXd eta;
   };
   struct Linearization;  // defined in the implementation
+  struct BestIterate;    // defined in the implementation
   using Online = OnlineGraphState<X, M, State>;
   struct PriorInformation {
     Eigen::Matrix<double, X, X> Lambda;

@@ -109,6 +109,28 @@ struct GraphSlam<Motion, Sensor>::Linearization {
   }
 };
 
+/// The lowest-cost iterate of one gauss_newton() so far, by the cost Levenberg-Marquardt accepts its
+/// steps by. (Ranking first by the factors an iterate leaves out, behind the camera, sent the
+/// visual-inertial runs back to their start, where fewer points are behind the camera.) Its estimate
+/// is copied only when it is offered and wins.
+template <class Motion, class Sensor>
+struct GraphSlam<Motion, Sensor>::BestIterate {
+  int iteration = -1;
+  double cost = 0.0;
+  std::vector<State> poses;
+  Eigen::VectorXd means;
+
+  /// Whether the kept iterate is better than the one linearized in `sys`.
+  bool beats(const Linearization& sys) const { return iteration >= 0 && cost < sys.cost; }
+  void offer(int at, const Linearization& sys, const std::vector<State>& estimate_poses, const Eigen::VectorXd& estimate_means) {
+    if (iteration >= 0 && !(sys.cost < cost)) return;
+    iteration = at;
+    cost = sys.cost;
+    poses = estimate_poses;
+    means = estimate_means;
+  }
+};
+
 template <class Motion, class Sensor>
 GraphSlam<Motion, Sensor>::GraphSlam(Motion motion, Sensor sensor, const PoseEstimate& prior, GraphOptions options)
     : motion_(std::move(motion)), sensor_(std::move(sensor)), options_(options), prior_(prior), newest_cov_(prior.cov) {
@@ -520,6 +542,9 @@ auto GraphSlam<Motion, Sensor>::newest_pose_marginal(const Linearization& sys) -
 }
 
 /// Gauss-Newton (or Levenberg-Marquardt) until the step or the relative change of chi2 is small.
+/// Plain Gauss-Newton does not descend monotonically: where an iteration ends on a higher cost than
+/// an earlier one (a far start, a robust kernel's reweighting, an iteration limit reached while it
+/// oscillates), the estimate returned is the best iterate's, not the last one's (`BestIterate`).
 template <class Motion, class Sensor>
 OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_count, int max_iterations,
                                                             Linearization* final_system) {
@@ -538,10 +563,12 @@ OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_cou
   };
   Linearization sys = timed_linearize();
   record_cost(sys.cost);
+  BestIterate best;
   double lambda = options_.levenberg_marquardt ? options_.initial_lambda : 0.0;
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
     const Eigen::VectorXd delta = solve(sys, lambda, summary);
     if (!delta.allFinite()) throw numerical_error("GraphSLAM step is not finite");
+    best.offer(summary.iterations, sys, poses_, landmarks_.means().stacked());
     const std::vector<State> poses_before = lambda > 0.0 ? poses_ : std::vector<State>{};
     const Eigen::VectorXd means_before = lambda > 0.0 ? landmarks_.means().stacked() : Eigen::VectorXd{};
     apply(sys, delta);
@@ -564,6 +591,13 @@ OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_cou
       summary.converged = true;
       break;
     }
+  }
+  summary.best_iteration = summary.iterations;
+  if (best.beats(sys)) {
+    poses_ = std::move(best.poses);
+    landmarks_.means().stacked() = best.means;
+    sys = timed_linearize();
+    summary.best_iteration = best.iteration;
   }
   summary.unobservable_factors = sys.unobservable;
   if (final_system) *final_system = std::move(sys);
