@@ -120,8 +120,13 @@ struct GraphSlam<Motion, Sensor>::BestIterate {
   std::vector<State> poses;
   Eigen::VectorXd means;
 
-  /// Whether the kept iterate is better than the one linearized in `sys`.
-  bool beats(const Linearization& sys) const { return iteration >= 0 && cost < sys.cost; }
+  /// Whether the kept iterate is better than the one linearized in `sys` by more than `tolerance` of
+  /// its cost (a rise within the tolerance that ends the iterations is rounding, not worth the
+  /// linearization a restore costs: on the linear ship the second iteration's cost differs from the
+  /// first's in its last bits).
+  bool beats(const Linearization& sys, double tolerance) const {
+    return iteration >= 0 && cost < sys.cost && sys.cost - cost > tolerance * cost;
+  }
   void offer(int at, const Linearization& sys, const std::vector<State>& estimate_poses, const Eigen::VectorXd& estimate_means) {
     if (iteration >= 0 && !(sys.cost < cost)) return;
     iteration = at;
@@ -593,7 +598,7 @@ OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_cou
     }
   }
   summary.best_iteration = summary.iterations;
-  if (best.beats(sys)) {
+  if (best.beats(sys, options_.relative_cost_tolerance)) {
     poses_ = std::move(best.poses);
     landmarks_.means().stacked() = best.means;
     sys = timed_linearize();
