@@ -54,12 +54,15 @@ class BlockColumnWriter {
         const ColumnBlock& first = blocks[k];
         std::size_t end = k + 1;
         while (end < blocks.size() && blocks[end].row == first.row) ++end;
-        for (int r = 0; r < first.height; ++r) {
-          double sum = first.at(r, c, width);
-          for (std::size_t d = k + 1; d < end; ++d) sum += blocks[d].at(r, c, width);
-          inner[at_] = static_cast<StorageIndex>(first.row + r);
-          value[at_++] = sum;
-        }
+        if (end == k + 1)
+          write_lone_column(first, c, width);
+        else
+          for (int r = 0; r < first.height; ++r) {
+            double sum = first.at(r, c, width);
+            for (std::size_t d = k + 1; d < end; ++d) sum += blocks[d].at(r, c, width);
+            inner[at_] = static_cast<StorageIndex>(first.row + r);
+            value[at_++] = sum;
+          }
         k = end;
       }
     }
@@ -75,6 +78,20 @@ class BlockColumnWriter {
   }
 
  private:
+  /// Column c of a block alone at its place (most blocks): a copy with one stride, chosen once per
+  /// column instead of per entry, and nothing to sum.
+  void write_lone_column(const ColumnBlock& block, int c, int width) {
+    const Eigen::Index stride = block.transposed ? width : 1;
+    const double* from = block.data + (block.transposed ? c : static_cast<Eigen::Index>(block.height) * c);
+    StorageIndex* inner = out_.innerIndexPtr() + at_;
+    double* value = out_.valuePtr() + at_;
+    for (int r = 0; r < block.height; ++r) {
+      inner[r] = static_cast<StorageIndex>(block.row + r);
+      value[r] = from[stride * r];
+    }
+    at_ += block.height;
+  }
+
   Eigen::SparseMatrix<double> out_;
   Eigen::Index column_ = 0;
   Eigen::Index at_ = 0;

@@ -26,6 +26,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "sextant/core/block_columns.hpp"
+
 namespace sextant {
 
 template <int Rows, int Cols = Rows>
@@ -51,46 +53,33 @@ class BlockSum {
 
   std::size_t blocks() const { return blocks_.size(); }
 
-  /// The sum as a compressed column-major matrix, written in place block column by block column: the
+  /// The sum as a compressed column-major matrix, written block column by block column by
+  /// core/block_columns.hpp's writer (GraphSLAM's full system's, each block alone at its place): the
   /// matrix BlockTriplets::to_sparse builds from the summed blocks (each entry once, so nothing is
   /// summed there), without its triplets and row-major copy. At the thesis's globe scale the reduced
   /// system has ~2 M entries, and those two buffers (~56 MB a solve, allocated afresh) cost a virtual
   /// machine that backs fresh pages slowly more than the solve's arithmetic (docs/benchmarks.md,
   /// "GraphSLAM's reduced system without triplets").
   Eigen::SparseMatrix<double> to_sparse(Eigen::Index rows, Eigen::Index cols) const {
+    eigen_assert(cols % Cols == 0 && "whole block columns");
     std::vector<std::size_t> order(blocks_.size());  // by block column, then block row
     std::iota(order.begin(), order.end(), std::size_t{0});
     std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
       return std::tie(blocks_[a].j, blocks_[a].i) < std::tie(blocks_[b].j, blocks_[b].i);
     });
-    std::vector<Eigen::Index> in_block_column((static_cast<std::size_t>(cols) + Cols - 1) / Cols, 0);
-    for (const auto& b : blocks_) ++in_block_column.at(b.j);
-    Eigen::SparseMatrix<double> out(rows, cols);
-    out.resizeNonZeros(Rows * Cols * static_cast<Eigen::Index>(blocks_.size()));
-    auto* outer = out.outerIndexPtr();
-    Eigen::Index at = 0;
-    for (Eigen::Index c = 0; c < cols; ++c) {
-      outer[c] = static_cast<StorageIndex>(at);
-      at += Rows * in_block_column[static_cast<std::size_t>(c / Cols)];
+    BlockColumnWriter out(rows, cols, Rows * Cols * static_cast<Eigen::Index>(blocks_.size()));
+    std::vector<ColumnBlock> column;
+    auto next = order.begin();
+    for (std::size_t j = 0; static_cast<Eigen::Index>(Cols * j) < cols; ++j) {
+      column.clear();
+      for (; next != order.end() && blocks_[*next].j == j; ++next)
+        column.push_back({Rows * static_cast<Eigen::Index>(blocks_[*next].i), Rows, blocks_[*next].sum.data()});
+      out.write(Cols, column);
     }
-    outer[cols] = static_cast<StorageIndex>(at);
-    std::vector<Eigen::Index> placed(in_block_column.size(), 0);  // blocks written in each block column
-    for (std::size_t k : order) {
-      const Entry& b = blocks_[k];
-      const Eigen::Index kth = placed[b.j]++;  // the block's place in its block column (rows ascending)
-      for (int cc = 0; cc < Cols; ++cc) {
-        const Eigen::Index first = outer[Cols * static_cast<Eigen::Index>(b.j) + cc] + Rows * kth;
-        for (int r = 0; r < Rows; ++r) {
-          out.innerIndexPtr()[first + r] = static_cast<StorageIndex>(Rows * static_cast<Eigen::Index>(b.i) + r);
-          out.valuePtr()[first + r] = b.sum(r, cc);
-        }
-      }
-    }
-    return out;
+    return out.finish();
   }
 
  private:
-  using StorageIndex = Eigen::SparseMatrix<double>::StorageIndex;
   struct Entry {
     std::size_t i, j;
     Block sum;
