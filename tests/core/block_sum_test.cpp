@@ -75,5 +75,12 @@ TEST(BlockSum, AnEmptySumIsTheZeroMatrix) {
   EXPECT_EQ(empty.nonZeros(), 0);
 }
 
+TEST(BlockSum, ABlockBeyondTheMatrixsColumnsIsRefused) {
+  BlockSum<6> sum;
+  sum.add(0, 3, Eigen::Matrix<double, 6, 6>::Identity());  // columns 18-23 of an 18-column matrix
+  EXPECT_THROW(sum.to_sparse(24, 18), std::out_of_range);
+  EXPECT_EQ(sum.to_sparse(24, 24).nonZeros(), 36);
+}
+
 }  // namespace
 }  // namespace sextant

@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <numeric>
+#include <stdexcept>
 #include <tuple>
 #include <unordered_map>
 #include <vector>
@@ -76,6 +77,7 @@ class BlockSum {
         column.push_back({Rows * static_cast<Eigen::Index>(blocks_[*next].i), Rows, blocks_[*next].sum.data()});
       out.write(Cols, column);
     }
+    if (next != order.end()) throw std::out_of_range("BlockSum::to_sparse: a block lies beyond the matrix's columns");
     return out.finish();
   }
 
