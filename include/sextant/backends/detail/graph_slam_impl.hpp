@@ -112,7 +112,8 @@ struct GraphSlam<Motion, Sensor>::Linearization {
 /// The lowest-cost iterate of one gauss_newton() so far, by the cost Levenberg-Marquardt accepts its
 /// steps by. (Ranking first by the factors an iterate leaves out, behind the camera, sent the
 /// visual-inertial runs back to their start, where fewer points are behind the camera.) Its estimate
-/// is copied only when it is offered and wins.
+/// is copied only when it is offered and wins; a tie goes to the later iterate, so that under
+/// Levenberg-Marquardt, which never moves to a higher cost, it is the iterate a rejected step returns to.
 template <class Motion, class Sensor>
 struct GraphSlam<Motion, Sensor>::BestIterate {
   int iteration = -1;
@@ -128,7 +129,7 @@ struct GraphSlam<Motion, Sensor>::BestIterate {
     return iteration >= 0 && cost < sys.cost && sys.cost - cost > tolerance * cost;
   }
   void offer(int at, const Linearization& sys, const std::vector<State>& estimate_poses, const Eigen::VectorXd& estimate_means) {
-    if (iteration >= 0 && !(sys.cost < cost)) return;
+    if (iteration >= 0 && !(sys.cost <= cost)) return;
     iteration = at;
     cost = sys.cost;
     poses = estimate_poses;
@@ -574,14 +575,12 @@ OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_cou
     const Eigen::VectorXd delta = solve(sys, lambda, summary);
     if (!delta.allFinite()) throw numerical_error("GraphSLAM step is not finite");
     best.offer(summary.iterations, sys, poses_, landmarks_.means().stacked());
-    const std::vector<State> poses_before = lambda > 0.0 ? poses_ : std::vector<State>{};
-    const Eigen::VectorXd means_before = lambda > 0.0 ? landmarks_.means().stacked() : Eigen::VectorXd{};
     apply(sys, delta);
     Linearization next = timed_linearize();
     ++summary.iterations;
-    if (lambda > 0.0 && next.cost > sys.cost) {  // rejected: back to where we were, damp more
-      poses_ = poses_before;
-      landmarks_.means().stacked() = means_before;
+    if (lambda > 0.0 && next.cost > sys.cost) {  // rejected: back to where we were (the best iterate), damp more
+      poses_ = best.poses;
+      landmarks_.means().stacked() = best.means;
       lambda *= 10.0;
       record_cost(sys.cost);
       continue;
