@@ -74,7 +74,6 @@ TEST(GraphSlam, ShipRunConvergesWithinTenIterationsAndBeatsEkf) {
   EXPECT_LT(graph_error, ekf_error);  // smoothing uses the future too
 }
 
-/// A planar robot with odometry and landmarks in its frame: nonlinear, needs relinearization.
 /// A robot driving a circle of radius 8 among twelve landmarks on a circle of radius 10, seeing those
 /// within 6 m ahead: noisy odometry and point measurements in its frame, and the true poses.
 struct Se2Circle {
@@ -109,6 +108,7 @@ Se2Circle se2_circle(int num_steps) {
   return {std::move(steps), std::move(true_poses), sensor};
 }
 
+/// A planar robot with odometry and landmarks in its frame: nonlinear, needs relinearization.
 TEST(GraphSlam, Se2ProblemConvergesAndWindowedInitializationAgrees) {
   const auto [steps, true_poses, sensor] = se2_circle(150);
   const Gaussian<Eigen::Vector3d, 3> prior{true_poses[0], 1e-6 * Eigen::Matrix3d::Identity()};
