@@ -35,7 +35,8 @@ std::vector<std::pair<std::string, double>> relocalization_extras(const Relocali
 
 std::vector<std::pair<std::string, double>> optimization_extras(const OptimizationRow& o) {
   return {{"optimization_unconverged", static_cast<double>(o.unconverged)},
-          {"optimization_iterations", static_cast<double>(o.iterations)}};
+          {"optimization_iterations", static_cast<double>(o.iterations)},
+          {"optimization_kept_iteration", static_cast<double>(o.kept_iteration)}};
 }
 
 namespace {
@@ -66,15 +67,23 @@ std::optional<AssociationRow> association_of(const eval::StudyRecord& r) {
                         has_extra(r, "association_searches_cut") ? static_cast<std::size_t>(r.extra("association_searches_cut")) : 0};
 }
 
-/// In how many of records[begin, end) the final optimization stopped unconverged; none for filters.
+/// In how many of records[begin, end) the final optimization stopped unconverged, and in how many it
+/// kept an earlier iterate than its last; none for filters.
 std::optional<OptimizationRow> optimization_of(std::vector<eval::StudyRecord>::const_iterator begin,
                                                std::vector<eval::StudyRecord>::const_iterator end) {
   if (!has_extra(*begin, "optimization_unconverged")) return std::nullopt;
-  OptimizationRow row{static_cast<int>(end - begin), 0, 0};
+  OptimizationRow row{.runs = static_cast<int>(end - begin)};
   for (auto r = begin; r != end; ++r) {
-    if (r->extra("optimization_unconverged") == 0.0) continue;
-    ++row.unconverged;
-    row.iterations = std::max(row.iterations, static_cast<int>(r->extra("optimization_iterations")));
+    const int iterations = static_cast<int>(r->extra("optimization_iterations"));
+    if (r->extra("optimization_unconverged") != 0.0) {
+      ++row.unconverged;
+      row.iterations = std::max(row.iterations, iterations);
+    }
+    const int kept = static_cast<int>(r->extra("optimization_kept_iteration"));
+    if (kept != iterations && row.kept_earlier++ == 0) {
+      row.kept_iteration = kept;
+      row.kept_of = iterations;
+    }
   }
   return row;
 }

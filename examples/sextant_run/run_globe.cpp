@@ -260,7 +260,7 @@ void print_globe_row(const GlobeRun& r, std::size_t steps) {
               share(s.map_nees_inside).c_str(), number(s.position_anees).c_str(), r.total_seconds,
               1e3 * r.total_seconds / static_cast<double>(steps));
   if (r.relocalization) print_relocalization(27, *r.relocalization);
-  if (r.optimization) print_unconverged(27, *r.optimization);
+  if (r.optimization) print_optimization(27, *r.optimization);
   print_skipped_steps(27, r.failures.total(), "step", r.failures.first);
 }
 

@@ -82,15 +82,27 @@ inline void print_relocalization(int indent, const RelocalizationRow& r) {
                 indent, "", r.stale_recoveries, r.steps);
 }
 
-/// The line below a GraphSLAM row whose final optimization (Gauss-Newton or Levenberg-Marquardt)
-/// stopped at its iteration limit before converging in some run: its estimate is then not the
-/// optimum the row's scores are meant to show.
-inline void print_unconverged(int indent, const OptimizationRow& o) {
-  if (o.unconverged == 0) return;
-  const std::string in_runs =
-      o.runs > 1 ? " in " + std::to_string(o.unconverged) + " of " + std::to_string(o.runs) + " runs" : std::string();
-  std::printf("%-*s optimization stopped at its limit of %d iteration%s before converging%s; [graph] max_iterations "
-              "raises it\n", indent, "", o.iterations, o.iterations == 1 ? "" : "s", in_runs.c_str());
+/// " in k of n runs" where a row has more than one run.
+inline std::string in_runs(int k, int runs) {
+  return runs > 1 ? " in " + std::to_string(k) + " of " + std::to_string(runs) + " runs" : std::string();
+}
+
+/// The lines below a GraphSLAM row whose final optimization (Gauss-Newton or Levenberg-Marquardt)
+/// stopped at its iteration limit before converging in some run (its estimate is then not the
+/// optimum the row's scores are meant to show), or kept an earlier iterate than its last (Gauss-Newton's
+/// cost rose after it: a start far from the optimum, where Levenberg-Marquardt descends).
+inline void print_optimization(int indent, const OptimizationRow& o) {
+  if (o.unconverged > 0)
+    std::printf("%-*s optimization stopped at its limit of %d iteration%s before converging%s; [graph] max_iterations "
+                "raises it\n", indent, "", o.iterations, o.iterations == 1 ? "" : "s", in_runs(o.unconverged, o.runs).c_str());
+  if (o.kept_earlier > 0) {
+    const std::string where = o.kept_iteration == 0 ? std::string("at its start, which it kept")
+                                                    : "at iteration " + std::to_string(o.kept_iteration) + ", whose estimate it kept";
+    std::printf("%-*s Gauss-Newton's cost was lowest %s, higher in the %d iteration%s after it%s; [graph] "
+                "levenberg_marquardt = true descends\n", indent, "", where.c_str(), o.kept_of - o.kept_iteration,
+                o.kept_of - o.kept_iteration == 1 ? "" : "s",
+                o.runs > 1 ? (in_runs(o.kept_earlier, o.runs) + ", the first of them shown").c_str() : "");
+  }
 }
 
 /// The pose ANEES, or "collapsed" where some steps' covariance rests on too few particles to be one
@@ -121,7 +133,7 @@ inline void print_row(const TableRow& row) {
                 "its NEES there the sample's; the ANEES over the other steps: %s\n", "", 100.0 * s.pose_undersampled,
                 cell("%.4g", s.pose_anees_supported).c_str());
   if (const auto& r = row.relocalization) print_relocalization(29, *r);
-  if (const auto& o = row.optimization) print_unconverged(29, *o);
+  if (const auto& o = row.optimization) print_optimization(29, *o);
   print_skipped_steps(29, row.summary.failed_steps, "step", row.summary.first_failure);  // over all its runs
 }
 
@@ -176,7 +188,8 @@ inline void write_summary_json(const std::string& path, const std::vector<TableR
         out << ", \"relocalizations\": " << json_number(r->relocalizations) << ", \"active_at_end\": " << json_number(r->active);
       if (r->stale_recoveries >= 0.0) out << ", \"stale_recoveries\": " << json_number(r->stale_recoveries);
     }
-    if (const auto& o = rows[i].optimization) out << ", \"optimization_unconverged_runs\": " << o->unconverged;
+    if (const auto& o = rows[i].optimization)
+      out << ", \"optimization_unconverged_runs\": " << o->unconverged << ", \"optimization_earlier_iterate_runs\": " << o->kept_earlier;
     out << "}" << (i + 1 < rows.size() ? ",\n" : "\n");
   }
   out << "]\n";

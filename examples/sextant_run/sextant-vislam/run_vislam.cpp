@@ -279,7 +279,7 @@ void print_table(const ViData& d, const std::vector<ViRun>& runs) {
                 r.in_state, r.updates.initialized, r.updates.corrected, r.updates.rejected, r.updates.unusable, number_or_dash(r.rmse, "%.2f").c_str(),
                 number_or_dash(dead_reckoning_rmse / r.rmse, "%.2fx").c_str(), number_or_dash(r.anees, "%.2f").c_str(),
                 1e3 * r.seconds / static_cast<double>(d.frames.size()));
-    if (r.optimization) print_unconverged(38, *r.optimization);
+    if (r.optimization) print_optimization(38, *r.optimization);
     print_skipped_steps(38, r.failures.total(), "frame", r.failures.first);
   }
   std::printf("RMSE: position against %s; vs DR: dead reckoning's RMSE over this one (higher is better); in state: "

@@ -23,11 +23,13 @@ struct NoStepCallback {
   void operator()(std::size_t) const {}
 };
 
-/// Full SLAM's final optimization: the Gauss-Newton iterations it took and whether it converged
-/// (step or cost change below its tolerance) before its iteration limit.
+/// Full SLAM's final optimization: the Gauss-Newton iterations it took, whether it converged
+/// (step or cost change below its tolerance) before its iteration limit, and the iteration whose
+/// estimate it kept (the last unless an earlier one had the lower cost).
 struct OptimizationOutcome {
   int iterations = 0;
   bool converged = true;
+  int best_iteration = 0;
 };
 
 /// Accuracy, consistency and time of one run.
@@ -131,13 +133,13 @@ void run_timed_steps(Backend& backend, const Dataset& dataset, Summary& out, Aft
 }
 
 /// Full SLAM's optimize(), its time added to out.total_seconds and, where it reports them, its
-/// iterations and convergence to out.optimization.
+/// iterations, convergence and kept iterate to out.optimization.
 template <class Backend, class Summary>
 void optimize_timed(Backend& backend, Summary& out) {
   const auto start = std::chrono::steady_clock::now();
   if constexpr (requires { backend.optimize().converged; }) {
     const auto summary = backend.optimize();
-    out.optimization = OptimizationOutcome{summary.iterations, summary.converged};
+    out.optimization = OptimizationOutcome{summary.iterations, summary.converged, summary.best_iteration};
   } else {
     backend.optimize();
   }
