@@ -36,6 +36,7 @@ std::vector<std::pair<std::string, double>> relocalization_extras(const Relocali
 std::vector<std::pair<std::string, double>> optimization_extras(const OptimizationRow& o) {
   return {{"optimization_unconverged", static_cast<double>(o.unconverged)},
           {"optimization_iterations", static_cast<double>(o.iterations)},
+          {"optimization_kept_earlier", static_cast<double>(o.kept_earlier)},
           {"optimization_kept_iteration", static_cast<double>(o.kept_iteration)}};
 }
 
@@ -79,9 +80,8 @@ std::optional<OptimizationRow> optimization_of(std::vector<eval::StudyRecord>::c
       ++row.unconverged;
       row.iterations = std::max(row.iterations, iterations);
     }
-    const int kept = static_cast<int>(r->extra("optimization_kept_iteration"));
-    if (kept != iterations && row.kept_earlier++ == 0) {
-      row.kept_iteration = kept;
+    if (r->extra("optimization_kept_earlier") != 0.0 && row.kept_earlier++ == 0) {
+      row.kept_iteration = static_cast<int>(r->extra("optimization_kept_iteration"));
       row.kept_of = iterations;
     }
   }
