@@ -44,6 +44,9 @@ int main(int argc, char** argv) {
                 summary.converged ? "converged" : "NOT converged", summary.cost.front(),
                 summary.cost[static_cast<std::size_t>(summary.best_iteration)],
                 summary.seconds_linearize, summary.seconds_eliminate, summary.seconds_solve, SparseCholesky::backend());
+    if (summary.damped_from >= 0)
+      std::printf("Gauss-Newton's chi2 rose at iteration %d: that step was undone and the steps after it damped "
+                  "(Levenberg-Marquardt)\n", summary.damped_from);
     if (summary.best_iteration != summary.iterations)
       std::printf("the estimate is iteration %d's, the lowest chi2; the last one ended at %.6g\n", summary.best_iteration,
                   summary.cost.back());

@@ -37,7 +37,8 @@ std::vector<std::pair<std::string, double>> optimization_extras(const Optimizati
   return {{"optimization_unconverged", static_cast<double>(o.unconverged)},
           {"optimization_iterations", static_cast<double>(o.iterations)},
           {"optimization_kept_earlier", static_cast<double>(o.kept_earlier)},
-          {"optimization_kept_iteration", static_cast<double>(o.kept_iteration)}};
+          {"optimization_kept_iteration", static_cast<double>(o.kept_iteration)},
+          {"optimization_damped_from", static_cast<double>(o.damped_from)}};
 }
 
 namespace {
@@ -68,8 +69,8 @@ std::optional<AssociationRow> association_of(const eval::StudyRecord& r) {
                         has_extra(r, "association_searches_cut") ? static_cast<std::size_t>(r.extra("association_searches_cut")) : 0};
 }
 
-/// In how many of records[begin, end) the final optimization stopped unconverged, and in how many it
-/// kept an earlier iterate than its last; none for filters.
+/// In how many of records[begin, end) the final optimization stopped unconverged, in how many it
+/// kept an earlier iterate than its last and in how many it went on damped; none for filters.
 std::optional<OptimizationRow> optimization_of(std::vector<eval::StudyRecord>::const_iterator begin,
                                                std::vector<eval::StudyRecord>::const_iterator end) {
   if (!has_extra(*begin, "optimization_unconverged")) return std::nullopt;
@@ -84,6 +85,8 @@ std::optional<OptimizationRow> optimization_of(std::vector<eval::StudyRecord>::c
       row.kept_iteration = static_cast<int>(r->extra("optimization_kept_iteration"));
       row.kept_of = iterations;
     }
+    const int damped_from = has_extra(*r, "optimization_damped_from") ? static_cast<int>(r->extra("optimization_damped_from")) : -1;
+    if (damped_from >= 0 && row.damped++ == 0) row.damped_from = damped_from;
   }
   return row;
 }

@@ -727,6 +727,8 @@ inline std::vector<ConfigKey> graph_keys() {
      }},
     {"graph", "levenberg_marquardt", "false", "damp the Gauss-Newton steps",
      [](RunnerConfig& c, const std::string& v) { c.graph.levenberg_marquardt = parse_bool(v); }},
+    {"graph", "damp_after_rise", "true", "Gauss-Newton: after an iteration whose cost rose, undo it and damp the steps after it",
+     [](RunnerConfig& c, const std::string& v) { c.graph.damp_after_rise = parse_bool(v); }},
     {"graph", "window", "0", "windowed initialization: optimize growing parts of this many steps first; 0 = off",
      [](RunnerConfig& c, const std::string& v) { c.graph.window = parse_integer<std::size_t>(v, 0); }},
     {"graph", "reuse_retired_marginals", "false",

@@ -89,8 +89,8 @@ inline std::string in_runs(int k, int runs) {
 
 /// The lines below a GraphSLAM row whose final optimization (Gauss-Newton or Levenberg-Marquardt)
 /// stopped at its iteration limit before converging in some run (its estimate is then not the
-/// optimum the row's scores are meant to show), or kept an earlier iterate than its last (Gauss-Newton's
-/// cost rose after it: a start far from the optimum, where Levenberg-Marquardt descends).
+/// optimum the row's scores are meant to show), went on damped after Gauss-Newton's cost rose (a start
+/// far from the optimum), or, with that off, kept an earlier iterate than its last.
 inline void print_optimization(int indent, const OptimizationRow& o) {
   if (o.unconverged > 0)
     std::printf("%-*s optimization stopped at its limit of %d iteration%s before converging%s; [graph] max_iterations "
@@ -99,10 +99,14 @@ inline void print_optimization(int indent, const OptimizationRow& o) {
     const std::string where = o.kept_iteration == 0 ? std::string("at its start, which it kept")
                                                     : "at iteration " + std::to_string(o.kept_iteration) + ", whose estimate it kept";
     std::printf("%-*s Gauss-Newton's cost was lowest %s, higher in the %d iteration%s after it%s; [graph] "
-                "levenberg_marquardt = true descends\n", indent, "", where.c_str(), o.kept_of - o.kept_iteration,
+                "damp_after_rise = true descends\n", indent, "", where.c_str(), o.kept_of - o.kept_iteration,
                 o.kept_of - o.kept_iteration == 1 ? "" : "s",
                 o.runs > 1 ? (in_runs(o.kept_earlier, o.runs) + ", the first of them shown").c_str() : "");
   }
+  if (o.damped > 0)
+    std::printf("%-*s Gauss-Newton's cost rose at iteration %d%s: that step was undone and the steps after it damped "
+                "(Levenberg-Marquardt)\n", indent, "", o.damped_from,
+                o.runs > 1 ? (in_runs(o.damped, o.runs) + ", the first of them shown").c_str() : "");
 }
 
 /// The pose ANEES, or "collapsed" where some steps' covariance rests on too few particles to be one
@@ -189,7 +193,8 @@ inline void write_summary_json(const std::string& path, const std::vector<TableR
       if (r->stale_recoveries >= 0.0) out << ", \"stale_recoveries\": " << json_number(r->stale_recoveries);
     }
     if (const auto& o = rows[i].optimization)
-      out << ", \"optimization_unconverged_runs\": " << o->unconverged << ", \"optimization_earlier_iterate_runs\": " << o->kept_earlier;
+      out << ", \"optimization_unconverged_runs\": " << o->unconverged << ", \"optimization_earlier_iterate_runs\": " << o->kept_earlier
+          << ", \"optimization_damped_runs\": " << o->damped;
     out << "}" << (i + 1 < rows.size() ? ",\n" : "\n");
   }
   out << "]\n";

@@ -72,20 +72,24 @@ struct RelocalizationRow {
 
 /// Full SLAM's final Gauss-Newton over a row's runs: in how many it stopped at its iteration limit
 /// before converging (eval::OptimizationOutcome), and that limit; in how many it kept an earlier
-/// iterate than its last (Gauss-Newton's cost rose after it), and which of how many (the first such run's).
+/// iterate than its last (Gauss-Newton's cost rose after it), and which of how many (the first such run's);
+/// in how many Gauss-Newton's cost rose and its steps went on damped, and at which iteration (the first
+/// such run's).
 struct OptimizationRow {
   int runs = 1, unconverged = 0, iterations = 0;
   int kept_earlier = 0, kept_iteration = 0, kept_of = 0;
+  int damped = 0, damped_from = -1;
 };
 
-/// One run's optimization as its row: `summary` has iterations, converged and best_iteration
-/// (GraphSlam's OptimizationSummary, eval::OptimizationOutcome).
+/// One run's optimization as its row: `summary` has iterations, converged, best_iteration and
+/// damped_from (GraphSlam's OptimizationSummary, eval::OptimizationOutcome).
 template <class Summary>
 OptimizationRow optimization_row(const Summary& summary) {
   const bool earlier = summary.best_iteration != summary.iterations;
   return OptimizationRow{.unconverged = summary.converged ? 0 : 1, .iterations = summary.iterations,
                          .kept_earlier = earlier ? 1 : 0, .kept_iteration = summary.best_iteration,
-                         .kept_of = summary.iterations};
+                         .kept_of = summary.iterations, .damped = summary.damped_from >= 0 ? 1 : 0,
+                         .damped_from = summary.damped_from};
 }
 
 /// A line of the comparison table. Every member has an initializer, so that a row is written with

@@ -149,19 +149,22 @@ TEST(GraphSlam, Se2ProblemConvergesAndWindowedInitializationAgrees) {
   EXPECT_LT(worst_nees, test::nees_bound(3, true_poses.size()));
 }
 
-/// Gauss-Newton from a far start does not descend monotonically (headings wrong by up to 5 rad): the
-/// estimate optimize() keeps is its best iterate's, not the last one's, and Levenberg-Marquardt from
-/// the same start never records a rise.
+/// Headings wrong by up to 5 rad: a start from which Gauss-Newton does not descend monotonically.
+std::vector<Eigen::Vector3d> far_headings(std::vector<Eigen::Vector3d> poses) {
+  for (std::size_t k = 0; k < poses.size(); ++k) poses[k].z() += 5.0 * std::sin(0.1 * static_cast<double>(k));
+  return poses;
+}
+
+/// Plain Gauss-Newton (damp_after_rise off) from a far start: the estimate optimize() keeps is its best
+/// iterate's, not the last one's, and Levenberg-Marquardt from the same start never records a rise.
 TEST(GraphSlam, GaussNewtonKeepsItsBestIterateWhereTheLastOneIsWorse) {
   const auto [steps, true_poses, sensor] = se2_circle(150);
   const Gaussian<Eigen::Vector3d, 3> prior{true_poses[0], 1e-6 * Eigen::Matrix3d::Identity()};
-  std::vector<Eigen::Vector3d> far_start = true_poses;
-  for (std::size_t k = 0; k < far_start.size(); ++k) far_start[k].z() += 5.0 * std::sin(0.1 * static_cast<double>(k));
   for (const bool damped : {false, true}) {
-    GraphSlam<Se2Odometry, PointInRobotFrame2D> graph{Se2Odometry{}, sensor, prior,
-                                                      {.max_iterations = 12, .levenberg_marquardt = damped}};
+    GraphSlam<Se2Odometry, PointInRobotFrame2D> graph{
+        Se2Odometry{}, sensor, prior, {.max_iterations = 12, .levenberg_marquardt = damped, .damp_after_rise = false}};
     eval::run(graph, steps);
-    graph.warm_start(far_start, {});
+    graph.warm_start(far_headings(true_poses), {});
     const auto summary = graph.optimize();
     const auto lowest = std::min_element(summary.cost.begin(), summary.cost.end());
     if (damped) {
@@ -171,8 +174,37 @@ TEST(GraphSlam, GaussNewtonKeepsItsBestIterateWhereTheLastOneIsWorse) {
       ASSERT_GT(summary.cost.back(), *lowest) << "this start no longer makes Gauss-Newton rise at its end";
       EXPECT_EQ(summary.best_iteration, lowest - summary.cost.begin());
     }
+    EXPECT_EQ(summary.damped_from, -1);
     EXPECT_EQ(graph.cost(), *lowest) << (damped ? "Levenberg-Marquardt" : "Gauss-Newton");
   }
+}
+
+/// By default Gauss-Newton goes on damped after its first rise: up to that iteration its costs are
+/// plain Gauss-Newton's, the rising step is undone, and from there the cost never rises, so the last
+/// iterate is the lowest; from this start it ends below plain Gauss-Newton's best iterate.
+TEST(GraphSlam, GaussNewtonGoesOnDampedAfterItsCostRises) {
+  const Se2Circle circle = se2_circle(150);
+  const Gaussian<Eigen::Vector3d, 3> prior{circle.true_poses[0], 1e-6 * Eigen::Matrix3d::Identity()};
+  auto optimized = [&](const GraphOptions& options) {
+    GraphSlam<Se2Odometry, PointInRobotFrame2D> graph{Se2Odometry{}, circle.sensor, prior, options};
+    eval::run(graph, circle.steps);
+    graph.warm_start(far_headings(circle.true_poses), {});
+    const auto summary = graph.optimize();
+    EXPECT_EQ(graph.cost(), summary.cost[static_cast<std::size_t>(summary.best_iteration)]);
+    return summary;
+  };
+  const auto plain = optimized({.max_iterations = 12, .damp_after_rise = false});
+  const auto safeguarded = optimized({.max_iterations = 12});
+  ASSERT_GE(safeguarded.damped_from, 1) << "this start no longer makes Gauss-Newton rise";
+  const auto rise = static_cast<std::size_t>(safeguarded.damped_from);
+  ASSERT_GT(plain.cost[rise], plain.cost[rise - 1]);  // plain Gauss-Newton rose at the same iteration
+  for (std::size_t k = 0; k < rise; ++k) EXPECT_EQ(safeguarded.cost[k], plain.cost[k]) << "iteration " << k;
+  EXPECT_EQ(safeguarded.cost[rise], safeguarded.cost[rise - 1]);  // the rising step undone
+  EXPECT_TRUE(std::is_sorted(safeguarded.cost.rbegin(), safeguarded.cost.rend()));
+  EXPECT_EQ(safeguarded.best_iteration, safeguarded.iterations);
+  EXPECT_LT(safeguarded.cost.back(), *std::min_element(plain.cost.begin(), plain.cost.end()));
+  std::printf("plain Gauss-Newton: lowest chi2 %.6g; damped after its rise at iteration %d: %.6g\n",
+              *std::min_element(plain.cost.begin(), plain.cost.end()), safeguarded.damped_from, safeguarded.cost.back());
 }
 
 /// Exact odometry cannot make a motion factor, which weighs by R^-1: the pose is refused with an

@@ -24,12 +24,14 @@ struct NoStepCallback {
 };
 
 /// Full SLAM's final optimization: the Gauss-Newton iterations it took, whether it converged
-/// (step or cost change below its tolerance) before its iteration limit, and the iteration whose
-/// estimate it kept (the last unless an earlier one had the lower cost).
+/// (step or cost change below its tolerance) before its iteration limit, the iteration whose
+/// estimate it kept (the last unless an earlier one had the lower cost), and the iteration whose cost
+/// rose, after which its steps were damped (-1: none; GraphOptions::damp_after_rise).
 struct OptimizationOutcome {
   int iterations = 0;
   bool converged = true;
   int best_iteration = 0;
+  int damped_from = -1;
 };
 
 /// Accuracy, consistency and time of one run.
@@ -139,7 +141,7 @@ void optimize_timed(Backend& backend, Summary& out) {
   const auto start = std::chrono::steady_clock::now();
   if constexpr (requires { backend.optimize().converged; }) {
     const auto summary = backend.optimize();
-    out.optimization = OptimizationOutcome{summary.iterations, summary.converged, summary.best_iteration};
+    out.optimization = OptimizationOutcome{summary.iterations, summary.converged, summary.best_iteration, summary.damped_from};
   } else {
     backend.optimize();
   }

@@ -128,6 +128,10 @@ struct GraphSlam<Motion, Sensor>::BestIterate {
   bool beats(const Linearization& sys, double tolerance) const {
     return iteration >= 0 && cost < sys.cost && sys.cost - cost > tolerance * cost;
   }
+  void restore(std::vector<State>& estimate_poses, Eigen::VectorXd& estimate_means) const {
+    estimate_poses = poses;
+    estimate_means = means;
+  }
   void offer(int at, const Linearization& sys, const std::vector<State>& estimate_poses, const Eigen::VectorXd& estimate_means) {
     if (iteration >= 0 && !(sys.cost <= cost)) return;
     iteration = at;
@@ -548,12 +552,14 @@ auto GraphSlam<Motion, Sensor>::newest_pose_marginal(const Linearization& sys) -
 }
 
 /// Gauss-Newton (or Levenberg-Marquardt) until the step or the relative change of chi2 is small.
-/// Plain Gauss-Newton does not descend monotonically: where an iteration ends on a higher cost than
-/// an earlier one (a far start, a robust kernel's reweighting, an iteration limit reached while it
-/// oscillates), the estimate returned is the best iterate's, not the last one's (`BestIterate`).
+/// Plain Gauss-Newton does not descend monotonically (a far start, a robust kernel's reweighting):
+/// with `damp_after_rise` the first iteration that ends on a higher cost is undone and the steps go on
+/// damped from the iterate before it, the lowest so far; without it, where an iteration ends on a
+/// higher cost than an earlier one, the estimate returned is the best iterate's, not the last one's
+/// (`BestIterate`).
 template <class Motion, class Sensor>
 OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_count, int max_iterations,
-                                                            Linearization* final_system) {
+                                                            Linearization* final_system, bool damp_after_rise) {
   using Clock = std::chrono::steady_clock;
   OptimizationSummary summary;
   const auto began = Clock::now();
@@ -578,9 +584,13 @@ OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_cou
     apply(sys, delta);
     Linearization next = timed_linearize();
     ++summary.iterations;
-    if (lambda > 0.0 && next.cost > sys.cost) {  // rejected: back to where we were (the best iterate), damp more
-      poses_ = best.poses;
-      landmarks_.means().stacked() = best.means;
+    const bool rose = next.cost > sys.cost;
+    if (lambda == 0.0 && damp_after_rise && summary.damped_from < 0 && best.beats(next, options_.relative_cost_tolerance)) {
+      summary.damped_from = summary.iterations;  // Gauss-Newton rose past rounding: undone below, damped from here
+      lambda = options_.initial_lambda / 10.0;
+    }
+    if (lambda > 0.0 && rose) {  // rejected: back to where we were (the best iterate), damp more
+      best.restore(poses_, landmarks_.means().stacked());
       lambda *= 10.0;
       record_cost(sys.cost);
       continue;
@@ -598,8 +608,7 @@ OptimizationSummary GraphSlam<Motion, Sensor>::gauss_newton(std::size_t pose_cou
   }
   summary.best_iteration = summary.iterations;
   if (best.beats(sys, options_.relative_cost_tolerance)) {
-    poses_ = std::move(best.poses);
-    landmarks_.means().stacked() = best.means;
+    best.restore(poses_, landmarks_.means().stacked());
     sys = timed_linearize();
     summary.best_iteration = best.iteration;
   }
@@ -638,7 +647,7 @@ OptimizationSummary GraphSlam<Motion, Sensor>::optimize() {
     RollbackGuard guard(poses_, landmarks_.means(), windows_done_);
     if (options_.window > 0 && !windows_done_) initialize_in_windows();
     Linearization final_system;
-    OptimizationSummary summary = gauss_newton(poses_.size(), options_.max_iterations, &final_system);
+    OptimizationSummary summary = gauss_newton(poses_.size(), options_.max_iterations, &final_system, options_.damp_after_rise);
     newest_cov_ = newest_pose_marginal(final_system);
     guard.commit();
     restart_online();  // the next update() linearizes the online system at the optimum
