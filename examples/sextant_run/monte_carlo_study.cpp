@@ -47,6 +47,12 @@ bool has_extra(const eval::StudyRecord& r, const char* name) {
   return std::any_of(r.extras.begin(), r.extras.end(), [&](const auto& e) { return e.first == name; });
 }
 
+/// An extra added after records were first written: `absent` in a record written before (extra()
+/// would give NaN, which no count or iteration number may be cast from).
+double extra_or(const eval::StudyRecord& r, const char* name, double absent) {
+  return has_extra(r, name) ? r.extra(name) : absent;
+}
+
 std::optional<CloudRow> cloud_of(const eval::StudyRecord& r) {
   if (!has_extra(r, "cloud_particles")) return std::nullopt;
   return CloudRow{r.extra("cloud_particles"), r.extra("cloud_effective_sample_size"), r.extra("cloud_distinct_ancestors")};
@@ -81,11 +87,11 @@ std::optional<OptimizationRow> optimization_of(std::vector<eval::StudyRecord>::c
       ++row.unconverged;
       row.iterations = std::max(row.iterations, iterations);
     }
-    if (r->extra("optimization_kept_earlier") != 0.0 && row.kept_earlier++ == 0) {
+    if (extra_or(*r, "optimization_kept_earlier", 0.0) != 0.0 && row.kept_earlier++ == 0) {
       row.kept_iteration = static_cast<int>(r->extra("optimization_kept_iteration"));
       row.kept_of = iterations;
     }
-    const int damped_from = has_extra(*r, "optimization_damped_from") ? static_cast<int>(r->extra("optimization_damped_from")) : -1;
+    const int damped_from = static_cast<int>(extra_or(*r, "optimization_damped_from", -1.0));
     if (damped_from >= 0 && row.damped++ == 0) row.damped_from = damped_from;
   }
   return row;
